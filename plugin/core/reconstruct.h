@@ -1,0 +1,194 @@
+#pragma once
+/// \file reconstruct.h
+/// The pipeline: samples (+ normals) -> implicit function -> SODS -> gated marching cubes ->
+/// surface with its boundary loops. Parameters in, result out, progress through a VCG callback.
+/// Throws ib::InputError, with a message that says what is wrong and what to do, on bad input.
+
+#include "boundaries.h"
+#include "gated_mc.h"
+#include "implicit/hoppe.h"
+#include "normals.h"
+#include "sods.h"
+
+#include <chrono>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+namespace ib {
+
+/// Bad input or parameters; what() is meant for the user.
+class InputError : public std::runtime_error
+{
+public:
+    using std::runtime_error::runtime_error;
+};
+
+class Reconstruction
+{
+public:
+    static constexpr int kMinPoints = 10;        ///< fewer samples cannot define tangent planes
+    static constexpr int kMinResolution = 8;
+    static constexpr int kMaxResolution = 4096;
+    /// Auto resolution: lattice cell = this × the typical sample spacing. One spacing puts a
+    /// sample in nearly every cell a uniformly sampled surface crosses, so with one dilation
+    /// ring the SODS has no gaps where the sampling has none.
+    static constexpr double kCellsPerSpacing = 1.0;
+
+    enum class NormalSource { LayerOrEstimate, Estimate };
+
+    struct Param
+    {
+        int resolution = 0;          ///< cells along the longest bbox side; 0 = from sample spacing
+        int sods_dilation = 1;       ///< 26-neighbourhood rings added around occupied cells
+        NormalSource normals = NormalSource::LayerOrEstimate;
+        int normal_neighbours = 10;  ///< k for normal estimation
+        std::optional<Eigen::Vector3d> viewpoint;  ///< orient estimated normals towards it
+        int hoppe_neighbours = 8;    ///< tangent planes blended by the signed distance
+        int threads = 0;             ///< 0 = all cores
+    };
+
+    struct Result
+    {
+        std::vector<BoundaryLoop> loops;  ///< boundary loops of the surface, largest first
+        int resolution = 0;
+        bool resolution_automatic = false;
+        double cell_size = 0;
+        double sample_spacing = 0;
+        Index3 lattice_cells = Index3::Zero();
+        size_t sods_cells = 0;
+        size_t evaluations = 0;
+        double lattice_corners = 0;  ///< what a full-lattice extraction would have evaluated
+        bool normals_estimated = false;
+        bool normals_flipped = false;
+        double seconds_normals = 0, seconds_implicit = 0, seconds_sods = 0, seconds_extraction = 0,
+               seconds_boundaries = 0;
+    };
+
+    /// P: n×3 samples; N: n×3 normals or empty (0 rows) when there are none.
+    /// `surface` receives the extracted surface (vertices welded, faces along the normals).
+    static Result Compute(const Points& P, const Points& N, const Param& p, CoreMesh& surface,
+                          vcg::CallBackPos* cb = nullptr)
+    {
+        using Clock = std::chrono::steady_clock;
+        auto seconds = [](Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); };
+        CheckInput(P, N, p);
+        Result r;
+
+        auto t = Clock::now();
+        Points normals;
+        if (p.normals == NormalSource::Estimate || !HasNormals(N)) {
+            if (cb) cb(2, "Estimating normals");
+            PointNormals::Param np;
+            np.neighbours = p.normal_neighbours;
+            np.viewpoint = p.viewpoint;
+            normals = PointNormals::Compute(P, np, &r.normals_flipped);
+            r.normals_estimated = true;
+        } else {
+            normals = N.rowwise().normalized();
+        }
+        r.seconds_normals = seconds(t);
+
+        t = Clock::now();
+        if (cb) cb(5, "Building the implicit function");
+        HoppeDistance f(P, normals, p.hoppe_neighbours, p.threads);
+        r.sample_spacing = SampleSpacing(P, p.threads);
+        r.seconds_implicit = seconds(t);
+
+        t = Clock::now();
+        const Eigen::Vector3d lo = P.colwise().minCoeff().transpose(), hi = P.colwise().maxCoeff().transpose();
+        const double longest = (hi - lo).maxCoeff();
+        r.resolution_automatic = p.resolution == 0;
+        r.resolution = p.resolution;
+        if (r.resolution_automatic)
+            r.resolution = std::clamp(int(std::lround(longest / (kCellsPerSpacing * r.sample_spacing))), kMinResolution, 1024);
+        const Lattice lattice = Lattice::Fit(lo, hi, r.resolution, p.sods_dilation + 1);
+        r.cell_size = lattice.cell_size;
+        r.lattice_cells = lattice.cells;
+        r.lattice_corners = lattice.CornerCount();
+        if (cb) cb(8, "Building the spatial occupancy data structure");
+        const Sods sods = Sods::FromSamples(lattice, P, p.sods_dilation);
+        r.sods_cells = sods.Count();
+        r.seconds_sods = seconds(t);
+
+        t = Clock::now();
+        r.evaluations = GatedMarchingCubes::Compute(lattice, sods, f, surface, cb).evaluations;
+        r.seconds_extraction = seconds(t);
+
+        t = Clock::now();
+        if (cb) cb(99, "Tracing boundary loops");
+        r.loops = BoundaryLoops::Compute(surface);
+        r.seconds_boundaries = seconds(t);
+        return r;
+    }
+
+    /// Typical distance between neighbouring samples: sqrt(area per sample), with the area per
+    /// sample estimated as pi r_k^2 / k from the distance r_k to the k-th neighbour (median over
+    /// up to 4096 evenly strided samples, so it ignores outliers and clusters).
+    static double SampleSpacing(const Points& P, int threads = 0)
+    {
+        const int k = std::min<int>(8, int(P.rows()) - 1);
+        vcg::KdTree<double> tree(vcg::ConstDataWrapper<vcg::Point3d>(reinterpret_cast<const vcg::Point3d*>(P.data()), int(P.rows())));
+        const Eigen::Index stride = std::max<Eigen::Index>(1, P.rows() / 4096);
+        std::vector<double> spacing(size_t((P.rows() + stride - 1) / stride));
+        ParallelFor(spacing.size(), threads, [&](size_t begin, size_t end, int) {
+            vcg::KdTree<double>::PriorityQueue queue;
+            for (size_t i = begin; i < end; ++i) {
+                const auto row = P.row(Eigen::Index(i) * stride);
+                tree.doQueryK(vcg::Point3d(row[0], row[1], row[2]), k + 1, queue);  // +1: the sample itself
+                spacing[i] = std::sqrt(M_PI * queue.getTopWeight() / k);
+            }
+        }, 256);
+        std::nth_element(spacing.begin(), spacing.begin() + spacing.size() / 2, spacing.end());
+        return spacing[spacing.size() / 2];
+    }
+
+    /// True when N holds a usable normal for every sample; false when it holds none at all
+    /// (no rows, or all zero: what a point cloud without normals gets in MeshLab).
+    static bool HasNormals(const Points& N)
+    {
+        return N.rows() > 0 && (N.rowwise().squaredNorm().array() > 0).any();
+    }
+
+private:
+    static void CheckInput(const Points& P, const Points& N, const Param& p)
+    {
+        std::ostringstream msg;
+        if (P.rows() == 0)
+            throw InputError("The layer has no vertices: select a point cloud or mesh layer with at least " +
+                             std::to_string(kMinPoints) + " vertices.");
+        if (P.rows() < kMinPoints)
+            throw InputError("The layer has only " + std::to_string(P.rows()) + " vertices; at least " +
+                             std::to_string(kMinPoints) + " samples are needed to fit tangent planes.");
+        const Eigen::Index bad = (!P.array().isFinite()).rowwise().any().count();
+        if (bad > 0)
+            throw InputError(std::to_string(bad) + " of " + std::to_string(P.rows()) +
+                             " vertices have NaN or infinite coordinates: remove them first "
+                             "(e.g. Filters > Cleaning and Repairing > Remove Duplicate and Unreferenced Vertices, "
+                             "or select them with Conditional Vertex Selection and delete).");
+        const Eigen::Vector3d extent = (P.colwise().maxCoeff() - P.colwise().minCoeff()).transpose();
+        if (!(extent.maxCoeff() > 0))
+            throw InputError("All vertices are at the same position: there is no surface to reconstruct.");
+        if (p.resolution != 0 && (p.resolution < kMinResolution || p.resolution > kMaxResolution))
+            throw InputError("Resolution " + std::to_string(p.resolution) + " is out of range: use 0 (automatic, " +
+                             "from the sample spacing) or a value between " + std::to_string(kMinResolution) +
+                             " and " + std::to_string(kMaxResolution) + ".");
+        if (p.sods_dilation < 0 || p.sods_dilation > 8)
+            throw InputError("SODS dilation must be between 0 and 8 rings (1 is the paper's 26-neighbourhood).");
+        if (p.normal_neighbours < 3 || p.normal_neighbours > 256)
+            throw InputError("Normal neighbours must be between 3 and 256.");
+        if (N.rows() != 0 && N.rows() != P.rows())
+            throw InputError("There must be one normal per vertex.");
+        if (p.normals == NormalSource::LayerOrEstimate && HasNormals(N)) {
+            const Eigen::Index unusable =
+                (!(N.array().isFinite().rowwise().all()) || !(N.rowwise().squaredNorm().array() > 0)).count();
+            if (unusable > 0)
+                throw InputError(std::to_string(unusable) + " of " + std::to_string(N.rows()) +
+                                 " vertex normals are zero or NaN: choose to estimate normals, or remove those "
+                                 "vertices (Conditional Vertex Selection with nx==0 && ny==0 && nz==0).");
+        }
+    }
+};
+
+} // namespace ib

@@ -1,0 +1,115 @@
+#pragma once
+/// \file sods.h
+/// Spatial occupancy data structure (SODS) of the implemented paper (README, "The method"),
+/// §3.1 "Initializing the SODS". A cell is occupied when it holds a sample; the occupancy is then dilated by the
+/// 26-neighbourhood (`rings` times) so that the implicit surface may pass through cells next
+/// to the samples. Stored sparsely as 8×8×8 bit bricks in a hash map, so memory grows with
+/// the occupied cells, not with the lattice volume.
+
+#include "lattice.h"
+
+#include <algorithm>
+#include <array>
+#include <unordered_map>
+#include <vector>
+
+namespace ib {
+
+class Sods
+{
+public:
+    explicit Sods(const Index3& cells) : cells_(cells) {}
+
+    /// Occupancy of the cells holding the n×3 samples P, dilated by `rings` 26-neighbourhood rings.
+    static Sods FromSamples(const Lattice& lattice, const Points& P, int rings)
+    {
+        Sods s(lattice.cells);
+        for (Eigen::Index i = 0; i < P.rows(); ++i)
+            s.Insert(lattice.CellOf(P.row(i).transpose()));
+        for (int r = 0; r < rings; ++r)
+            s = s.Dilated();
+        return s;
+    }
+
+    void Insert(const Index3& c)
+    {
+        Brick& b = bricks_[BrickKey(c)];
+        const int bit = BitOf(c);
+        if (!(b[bit >> 6] & (uint64_t(1) << (bit & 63)))) {
+            b[bit >> 6] |= uint64_t(1) << (bit & 63);
+            ++count_;
+        }
+    }
+
+    bool Contains(const Index3& c) const
+    {
+        if ((c.array() < 0).any() || (c.array() >= cells_.array()).any())
+            return false;
+        auto it = bricks_.find(BrickKey(c));
+        if (it == bricks_.end())
+            return false;
+        const int bit = BitOf(c);
+        return it->second[bit >> 6] & (uint64_t(1) << (bit & 63));
+    }
+
+    /// Number of occupied cells.
+    size_t Count() const { return count_; }
+
+    /// Bytes held by the bricks (payload only).
+    size_t Bytes() const { return bricks_.size() * sizeof(Brick); }
+
+    /// The occupancy grown by one ring of 26-neighbours, clipped to the lattice.
+    Sods Dilated() const
+    {
+        Sods out(cells_);
+        ForEach([&](const Index3& c) {
+            for (int dz = -1; dz <= 1; ++dz)
+                for (int dy = -1; dy <= 1; ++dy)
+                    for (int dx = -1; dx <= 1; ++dx) {
+                        const Index3 n = c + Index3(dx, dy, dz);
+                        if ((n.array() >= 0).all() && (n.array() < cells_.array()).all())
+                            out.Insert(n);
+                    }
+        });
+        return out;
+    }
+
+    /// Occupied cells sorted by (z, y, x): a deterministic order independent of hashing.
+    std::vector<Index3> Cells() const
+    {
+        std::vector<uint64_t> keys;
+        keys.reserve(count_);
+        ForEach([&](const Index3& c) { keys.push_back(PackIndex(c[0], c[1], c[2])); });
+        std::sort(keys.begin(), keys.end());
+        std::vector<Index3> out(keys.size());
+        std::transform(keys.begin(), keys.end(), out.begin(), UnpackIndex);
+        return out;
+    }
+
+    /// Calls f(cell) for each occupied cell, in no particular order.
+    template <class F>
+    void ForEach(F&& f) const
+    {
+        for (const auto& [key, brick] : bricks_) {
+            const Index3 base = UnpackIndex(key) * kBrick;
+            for (int w = 0; w < int(brick.size()); ++w)
+                for (uint64_t bits = brick[w]; bits; bits &= bits - 1) {
+                    const int bit = w * 64 + __builtin_ctzll(bits);
+                    f(Index3(base[0] + (bit & 7), base[1] + ((bit >> 3) & 7), base[2] + (bit >> 6)));
+                }
+        }
+    }
+
+private:
+    static constexpr int kBrick = 8;
+    using Brick = std::array<uint64_t, kBrick * kBrick * kBrick / 64>;
+
+    static uint64_t BrickKey(const Index3& c) { return PackIndex(c[0] >> 3, c[1] >> 3, c[2] >> 3); }
+    static int BitOf(const Index3& c) { return (c[0] & 7) | ((c[1] & 7) << 3) | ((c[2] & 7) << 6); }
+
+    Index3 cells_;
+    std::unordered_map<uint64_t, Brick> bricks_;
+    size_t count_ = 0;
+};
+
+} // namespace ib
