@@ -7,9 +7,8 @@
 
 namespace {
 
-const QStringList kNormalSources = {
-	"Use the layer's normals (estimate if it has none)",
-	"Always estimate normals"};
+// Order matches ib::Reconstruction::NormalSource.
+const QStringList kNormalSources = {"Use layer normals", "Estimate"};
 
 ib::Points vertexMatrix(const CMeshO& m, bool normals)
 {
@@ -135,9 +134,10 @@ RichParameterList FilterImplicitBoundariesPlugin::reconstructionParameters(const
 		true));
 	par.addParam(RichEnum(
 		"normals", int(d.normals), kNormalSources, "Normals",
-		"Where the oriented normals that define inside and outside come from. A point cloud "
-		"without normals (all zero) always gets estimated normals (PCA over neighbours, "
-		"oriented by propagation); the log says when this happened."));
+		"Where the oriented normals that define inside and outside come from. 'Use layer normals' "
+		"takes the layer's own (a scan's normals are usually best) and estimates them only when "
+		"the layer has none (all zero); 'Estimate' always fits them (PCA over neighbours, "
+		"oriented by propagation). The log says when normals were estimated."));
 	par.addParam(RichInt(
 		"normal_neighbours", d.normal_neighbours, "Normal estimation neighbours",
 		"Samples used to fit each tangent plane when normals are estimated. Raise it for noisy "

@@ -1,0 +1,13 @@
+"""Implicit surface reconstruction with boundaries, as a MeshLab filter usable from pymeshlab.
+
+    import pymeshlab, implicit_boundaries
+    implicit_boundaries.load()            # loads the plugin, binds the MeshSet method
+    ms = pymeshlab.MeshSet(); ms.load_new_mesh("scan.ply")
+    out = ms.generate_surface_reconstruction_implicit_with_boundaries(resolution=128)
+
+or, with numpy arrays only, :func:`reconstruct`.
+"""
+from ._plugin import FILTER_NAME, load, plugin_path
+from .reconstruct import Reconstruction, loops_from_result, reconstruct
+
+__all__ = ["FILTER_NAME", "load", "plugin_path", "reconstruct", "Reconstruction", "loops_from_result"]

@@ -1,0 +1,39 @@
+"""Finding the compiled MeshLab plugin and loading it into pymeshlab."""
+import os
+from pathlib import Path
+
+import pymeshlab
+
+FILTER_NAME = "generate_surface_reconstruction_implicit_with_boundaries"
+PLUGIN_FILE = "libfilter_implicit_boundaries.so"
+
+
+def plugin_path() -> Path:
+    """Path of the plugin module: $IMPLICIT_BOUNDARIES_PLUGIN, else the one built beside this package."""
+    path = Path(os.environ.get("IMPLICIT_BOUNDARIES_PLUGIN") or Path(__file__).parent / "lib" / PLUGIN_FILE)
+    if not path.is_file():
+        raise FileNotFoundError(
+            f"the plugin {path} is not built: run 'make' at the repository root "
+            "(or set IMPLICIT_BOUNDARIES_PLUGIN to a built libfilter_implicit_boundaries.so)")
+    return path
+
+
+def _bound_method(self, **kwargs):
+    return self.apply_filter(FILTER_NAME, **kwargs)
+
+
+def load() -> Path:
+    """Loads the plugin into pymeshlab (once per process) and binds
+    ``MeshSet.generate_surface_reconstruction_implicit_with_boundaries``; returns the plugin path.
+
+    pymeshlab binds filter methods only for the plugins present when it is imported, so the
+    method is bound here.
+    """
+    path = plugin_path()
+    if FILTER_NAME not in pymeshlab.filter_list():
+        pymeshlab.load_plugin(str(path))
+    if not hasattr(pymeshlab.MeshSet, FILTER_NAME):
+        _bound_method.__name__ = FILTER_NAME
+        _bound_method.__doc__ = "Implicit reconstruction with boundaries (see pymeshlab.print_filter_parameter_list)."
+        setattr(pymeshlab.MeshSet, FILTER_NAME, _bound_method)
+    return path

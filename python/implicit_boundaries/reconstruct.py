@@ -1,0 +1,63 @@
+"""numpy in, numpy out: the filter without pymeshlab objects."""
+from dataclasses import dataclass, field
+from typing import Dict, List, Optional
+
+import numpy as np
+import pymeshlab
+
+from ._plugin import FILTER_NAME, load
+
+NORMALS = {False: "Use layer normals", True: "Estimate"}
+
+
+@dataclass
+class Reconstruction:
+    """Result of :func:`reconstruct`.
+
+    vertices: (m, 3) float64 positions; faces: (f, 3) int32 vertex indices, oriented along the
+    input normals; loops: one int array of vertex indices per boundary loop (a closed cycle, the
+    first vertex not repeated), largest first; info: the filter's result dictionary
+    (resolution, cell_size, implicit_evaluations, per-stage seconds, ...).
+    """
+    vertices: np.ndarray
+    faces: np.ndarray
+    loops: List[np.ndarray]
+    info: Dict[str, object] = field(default_factory=dict)
+
+    def loop_polylines(self) -> List[np.ndarray]:
+        """Each boundary loop as a closed (k+1, 3) polyline (first point repeated at the end)."""
+        return [self.vertices[np.append(loop, loop[0])] for loop in self.loops]
+
+
+def loops_from_result(result: Dict[str, object]) -> List[np.ndarray]:
+    """Splits the filter's flat ``boundary_loop_vertices`` by ``boundary_loop_edges`` into loops."""
+    edges = np.asarray(result.get("boundary_loop_edges", []), dtype=np.int64)
+    vertices = np.asarray(result.get("boundary_loop_vertices", []), dtype=np.int64)
+    return np.split(vertices, np.cumsum(edges)[:-1]) if len(edges) else []
+
+
+def reconstruct(points, normals: Optional[np.ndarray] = None, resolution: int = 0, sods_dilation: int = 1,
+                estimate_normals: bool = False, normal_neighbours: int = 10) -> Reconstruction:
+    """Reconstructs the surface with boundaries of the (n, 3) ``points``.
+
+    normals: (n, 3) outward normals, or None to estimate them. resolution: cells along the
+    longest bounding-box side, 0 = automatic from the sample spacing. sods_dilation: rings of
+    neighbour cells in which the surface may pass without samples. Raises
+    pymeshlab.PyMeshLabException with the filter's message on bad input.
+    """
+    load()
+    points = np.ascontiguousarray(points, dtype=np.float64).reshape(-1, 3)
+    if normals is None:
+        mesh = pymeshlab.Mesh(vertex_matrix=points)
+    else:
+        normals = np.ascontiguousarray(normals, dtype=np.float64).reshape(-1, 3)
+        if normals.shape != points.shape:
+            raise ValueError(f"normals have shape {normals.shape}, points {points.shape}: one normal per point")
+        mesh = pymeshlab.Mesh(vertex_matrix=points, v_normals_matrix=normals)
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(mesh, "points")
+    info = ms.apply_filter(FILTER_NAME, resolution=resolution, sods_dilation=sods_dilation,
+                           normals=NORMALS[bool(estimate_normals)],
+                           normal_neighbours=normal_neighbours)
+    out = ms.current_mesh()
+    return Reconstruction(out.vertex_matrix(), out.face_matrix(), loops_from_result(info), dict(info))
