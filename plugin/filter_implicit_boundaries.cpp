@@ -9,6 +9,8 @@ namespace {
 
 // Order matches ib::Reconstruction::NormalSource.
 const QStringList kNormalSources = {"Use layer normals", "Estimate"};
+// Order matches ib::Reconstruction::Occupancy.
+const QStringList kOccupancies = {"Tangent disks", "Sample cells (paper)"};
 
 ib::Points vertexMatrix(const CMeshO& m, bool normals)
 {
@@ -119,18 +121,31 @@ RichParameterList FilterImplicitBoundariesPlugin::reconstructionParameters(const
 	par.addParam(RichInt(
 		"resolution", d.resolution, "Resolution (cells, 0 = automatic)",
 		QString("Marching cubes cells along the longest side of the bounding box; the SODS uses the "
-				"same lattice. 0 chooses it from the sample spacing (one cell per typical distance "
-				"between neighbouring samples, so a uniformly sampled surface leaves no gap) and "
-				"logs the value. Raise it for more detail; lower it to close more undersampled "
-				"gaps. Allowed: 0 or %1..%2.")
+				"same lattice. 0 chooses it from the sample spacing (a cell of 0.6 times the typical "
+				"distance between neighbouring samples) and logs the value. Raise it for more detail "
+				"and tighter boundaries; lower it to close more undersampled gaps and run faster. "
+				"Allowed: 0 or %1..%2.")
 			.arg(ib::Reconstruction::kMinResolution)
 			.arg(ib::Reconstruction::kMaxResolution)));
+	par.addParam(RichEnum(
+		"sods_occupancy", int(d.occupancy), kOccupancies, "SODS occupancy",
+		"Which lattice cells the samples mark in the spatial occupancy data structure (SODS); "
+		"the surface is only extracted in marked cells. 'Tangent disks': each sample marks the "
+		"cells crossed by a disk in its tangent plane whose radius follows the local sample "
+		"spacing, so sparse regions stay covered while real holes stay open. 'Sample cells "
+		"(paper)': the cell holding each sample, meant to be used with a dilation of 1."));
+	par.addParam(RichFloat(
+		"sample_radius", d.sample_radius, "Tangent disk radius (spacings)",
+		"Radius of each sample's tangent disk, in units of the local sample spacing (distance "
+		"between neighbouring samples). Raise it if the result has small spurious holes where "
+		"the scan is sparse; lower it to keep narrow real holes open.",
+		true));
 	par.addParam(RichInt(
 		"sods_dilation", d.sods_dilation, "SODS dilation (rings)",
-		"Rings of 26-neighbour cells added around the cells that hold samples; the surface may "
-		"only be extracted inside this region. 1 is the paper's choice. Raise it if the result "
-		"has spurious small holes; lower it (0) to cut the surface tighter at real boundaries "
-		"(each ring extends the surface by about one cell across a boundary).",
+		"Rings of 26-neighbour cells added around the marked cells. 0 suits tangent disks; the "
+		"paper uses 1 with sample cells. Raise it if the result has spurious small holes (noisy "
+		"scans); each ring extends the surface by about one cell across real boundaries and "
+		"closes holes narrower than two cells.",
 		true));
 	par.addParam(RichEnum(
 		"normals", int(d.normals), kNormalSources, "Normals",
@@ -171,6 +186,8 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 	p.sods_dilation = par.getInt("sods_dilation");
 	p.normals = ib::Reconstruction::NormalSource(par.getEnum("normals"));
 	p.normal_neighbours = par.getInt("normal_neighbours");
+	p.occupancy = ib::Reconstruction::Occupancy(par.getEnum("sods_occupancy"));
+	p.sample_radius = par.getFloat("sample_radius");
 
 	ib::CoreMesh surface;
 	ib::Reconstruction::Result r;

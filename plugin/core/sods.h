@@ -1,9 +1,10 @@
 #pragma once
 /// \file sods.h
 /// Spatial occupancy data structure (SODS) of the implemented paper (README, "The method"),
-/// §3.1 "Initializing the SODS". A cell is occupied when it holds a sample; the occupancy is then dilated by the
-/// 26-neighbourhood (`rings` times) so that the implicit surface may pass through cells next
-/// to the samples. Stored sparsely as 8×8×8 bit bricks in a hash map, so memory grows with
+/// §3.1 "Initializing the SODS". In the paper a cell is occupied when it holds a sample, and
+/// the occupancy is dilated by the 26-neighbourhood so that the implicit surface may pass
+/// through cells next to the samples. We also offer tangent-disk occupancy (FromDisks), which
+/// covers sparse regions without growing the occupancy across real holes. Stored sparsely as 8×8×8 bit bricks in a hash map, so memory grows with
 /// the occupied cells, not with the lattice volume.
 
 #include "lattice.h"
@@ -20,14 +21,42 @@ class Sods
 public:
     explicit Sods(const Index3& cells) : cells_(cells) {}
 
-    /// Occupancy of the cells holding the n×3 samples P, dilated by `rings` 26-neighbourhood rings.
-    static Sods FromSamples(const Lattice& lattice, const Points& P, int rings)
+    /// Occupancy of the cells holding the n×3 samples P (the paper's SODS before dilation).
+    static Sods FromSamples(const Lattice& lattice, const Points& P)
     {
         Sods s(lattice.cells);
         for (Eigen::Index i = 0; i < P.rows(); ++i)
             s.Insert(lattice.CellOf(P.row(i).transpose()));
-        for (int r = 0; r < rings; ++r)
-            s = s.Dilated();
+        return s;
+    }
+
+    /// Occupancy of the cells that the samples' tangent disks pass through: sample i with unit
+    /// normal N.row(i) covers the disk of radius radius[i] around it in its tangent plane,
+    /// thickened by `thickness` × radius[i] on each side along the normal (room for noise and
+    /// for the implicit surface's departures from the planes). With radii from the local sample
+    /// spacing, sparse regions stay covered while gaps wider than two radii stay open.
+    static Sods FromDisks(const Lattice& lattice, const Points& P, const Points& N,
+                          const Eigen::VectorXd& radius, double thickness)
+    {
+        Sods s(lattice.cells);
+        const double a = 0.5 * lattice.cell_size;
+        for (Eigen::Index i = 0; i < P.rows(); ++i) {
+            const Eigen::Vector3d p = P.row(i).transpose(), n = N.row(i).transpose();
+            const double r = radius[i];
+            const double slab = a * n.cwiseAbs().sum() + thickness * r;
+            const double reach = r + a * std::sqrt(3.0);
+            const Eigen::Vector3d box = Eigen::Vector3d::Constant(std::max(r, thickness * r));
+            const Index3 lo = lattice.CellOf(p - box), hi = lattice.CellOf(p + box);
+            for (int z = lo[2]; z <= hi[2]; ++z)
+                for (int y = lo[1]; y <= hi[1]; ++y)
+                    for (int x = lo[0]; x <= hi[0]; ++x) {
+                        const Eigen::Vector3d d = lattice.Corner(x, y, z) + Eigen::Vector3d::Constant(a) - p;
+                        const double h = n.dot(d);
+                        if (std::abs(h) <= slab && (d - h * n).norm() <= reach)
+                            s.Insert(Index3(x, y, z));
+                    }
+            s.Insert(lattice.CellOf(p));
+        }
         return s;
     }
 

@@ -1,5 +1,7 @@
 #include "sods.h"
 
+#include <Eigen/Geometry>
+
 #include <gtest/gtest.h>
 
 using namespace ib;
@@ -20,7 +22,7 @@ TEST(Sods, OccupiesTheCellsHoldingSamples)
     P << 0.5, 0.5, 0.5,   // cell (0,0,0)
          0.7, 0.2, 0.9,   // same cell again
          5.5, 2.1, 7.9;   // cell (5,2,7)
-    const Sods s = Sods::FromSamples(UnitLattice(10), P, 0);
+    const Sods s = Sods::FromSamples(UnitLattice(10), P);
     EXPECT_EQ(s.Count(), 2u);
     EXPECT_TRUE(s.Contains(Index3(0, 0, 0)));
     EXPECT_TRUE(s.Contains(Index3(5, 2, 7)));
@@ -32,14 +34,14 @@ TEST(Sods, DilationAddsThe26Neighbourhood)
 {
     Points P(1, 3);
     P << 4.5, 4.5, 4.5;
-    const Sods s = Sods::FromSamples(UnitLattice(10), P, 1);
+    const Sods s = Sods::FromSamples(UnitLattice(10), P).Dilated();
     EXPECT_EQ(s.Count(), 27u);
     for (int dz = -1; dz <= 1; ++dz)
         for (int dy = -1; dy <= 1; ++dy)
             for (int dx = -1; dx <= 1; ++dx)
                 EXPECT_TRUE(s.Contains(Index3(4 + dx, 4 + dy, 4 + dz)));
     EXPECT_FALSE(s.Contains(Index3(6, 4, 4)));
-    EXPECT_EQ(Sods::FromSamples(UnitLattice(10), P, 2).Count(), 125u);
+    EXPECT_EQ(Sods::FromSamples(UnitLattice(10), P).Dilated().Dilated().Count(), 125u);
 }
 
 TEST(Sods, DilationIsClippedToTheLatticeAndCrossesBrickBorders)
@@ -47,7 +49,7 @@ TEST(Sods, DilationIsClippedToTheLatticeAndCrossesBrickBorders)
     Points P(2, 3);
     P << 0.5, 0.5, 0.5,   // corner of the lattice: 8 cells after one ring
          7.5, 7.5, 7.5;   // last cell of brick (0,0,0): its neighbours lie in 8 bricks
-    const Sods s = Sods::FromSamples(UnitLattice(20), P, 1);
+    const Sods s = Sods::FromSamples(UnitLattice(20), P).Dilated();
     EXPECT_EQ(s.Count(), 8u + 27u);
     EXPECT_TRUE(s.Contains(Index3(8, 8, 8)));
     EXPECT_TRUE(s.Contains(Index3(6, 8, 7)));
@@ -57,10 +59,60 @@ TEST(Sods, CellsAreSortedAndUnique)
 {
     Points P(4, 3);
     P << 9.5, 0.5, 0.5, 0.5, 9.5, 0.5, 0.5, 0.5, 9.5, 0.5, 0.5, 0.5;
-    const auto cells = Sods::FromSamples(UnitLattice(16), P, 0).Cells();
+    const auto cells = Sods::FromSamples(UnitLattice(16), P).Cells();
     ASSERT_EQ(cells.size(), 4u);
     EXPECT_EQ(cells[0], Index3(0, 0, 0));
     EXPECT_EQ(cells[1], Index3(9, 0, 0));
     EXPECT_EQ(cells[2], Index3(0, 9, 0));
     EXPECT_EQ(cells[3], Index3(0, 0, 9));
+}
+
+TEST(Sods, TangentDiskCoversItsPlaneOnly)
+{
+    // A disk of radius 2.2 around (5.5, 5.5, 5.5) in the plane z = 5.5: cells of the slab z = 5
+    // whose centre is within 2.2 + half a cell diagonal; nothing above or below.
+    Points P(1, 3), N(1, 3);
+    P << 5.5, 5.5, 5.5;
+    N << 0, 0, 1;
+    const Sods s = Sods::FromDisks(UnitLattice(12), P, N, Eigen::VectorXd::Constant(1, 2.2), 0.0);
+    EXPECT_TRUE(s.Contains(Index3(5, 5, 5)));
+    EXPECT_TRUE(s.Contains(Index3(7, 5, 5)));
+    EXPECT_TRUE(s.Contains(Index3(3, 6, 5)));
+    EXPECT_FALSE(s.Contains(Index3(5, 5, 4)));
+    EXPECT_FALSE(s.Contains(Index3(5, 5, 6)));
+    EXPECT_FALSE(s.Contains(Index3(9, 5, 5)));
+    s.ForEach([](const Index3& c) { EXPECT_EQ(c[2], 5); });
+}
+
+TEST(Sods, TangentDisksOfUniformSamplesLeaveNoGapAtFineCells)
+{
+    // Samples on a 1-spaced grid in a tilted plane, cells of 0.3: every cell the plane crosses
+    // near the middle of the patch is covered by disks of radius 0.8 (more than the 0.71
+    // covering radius of a unit square grid).
+    const Eigen::Vector3d n = Eigen::Vector3d(0.2, 0.3, 1).normalized();
+    const Eigen::Vector3d u = n.cross(Eigen::Vector3d::UnitX()).normalized(), v = n.cross(u);
+    Points P(21 * 21, 3), N(21 * 21, 3);
+    for (int i = 0; i < 21; ++i)
+        for (int j = 0; j < 21; ++j) {
+            P.row(i * 21 + j) = (Eigen::Vector3d::Constant(10) + (i - 10) * u + (j - 10) * v).transpose();
+            N.row(i * 21 + j) = n.transpose();
+        }
+    Lattice l;
+    l.cell_size = 0.3;
+    l.cells = Index3(67, 67, 67);
+    const Sods s = Sods::FromDisks(l, P, N, Eigen::VectorXd::Constant(P.rows(), 0.8), 0.0);
+    int crossed = 0;
+    for (int z = 0; z < 67; ++z)
+        for (int y = 0; y < 67; ++y)
+            for (int x = 0; x < 67; ++x) {
+                const Eigen::Vector3d c = l.Corner(x, y, z) + Eigen::Vector3d::Constant(0.15) - Eigen::Vector3d::Constant(10);
+                const double h = n.dot(c);
+                const bool planeCrosses = std::abs(h) < 0.15 * n.cwiseAbs().sum() - 1e-9;  // not just touching
+                const Eigen::Vector3d inPlane = c - h * n;
+                if (planeCrosses && std::abs(inPlane.dot(u)) < 8 && std::abs(inPlane.dot(v)) < 8) {
+                    ++crossed;
+                    EXPECT_TRUE(s.Contains(Index3(x, y, z))) << x << " " << y << " " << z;
+                }
+            }
+    EXPECT_GT(crossed, 2000);
 }
