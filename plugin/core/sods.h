@@ -32,20 +32,19 @@ public:
 
     /// Occupancy of the cells that the samples' tangent disks pass through: sample i with unit
     /// normal N.row(i) covers the disk of radius radius[i] around it in its tangent plane,
-    /// thickened by `thickness` × radius[i] on each side along the normal (room for noise and
-    /// for the implicit surface's departures from the planes). With radii from the local sample
-    /// spacing, sparse regions stay covered while gaps wider than two radii stay open.
+    /// thickened by `slack` (world units) on each side along the normal. With radii from the
+    /// local sample spacing, sparse regions stay covered while gaps wider than two radii stay open.
     static Sods FromDisks(const Lattice& lattice, const Points& P, const Points& N,
-                          const Eigen::VectorXd& radius, double thickness)
+                          const Eigen::VectorXd& radius, double slack)
     {
         Sods s(lattice.cells);
         const double a = 0.5 * lattice.cell_size;
         for (Eigen::Index i = 0; i < P.rows(); ++i) {
             const Eigen::Vector3d p = P.row(i).transpose(), n = N.row(i).transpose();
             const double r = radius[i];
-            const double slab = a * n.cwiseAbs().sum() + thickness * r;
+            const double slab = a * n.cwiseAbs().sum() + slack;
             const double reach = r + a * std::sqrt(3.0);
-            const Eigen::Vector3d box = Eigen::Vector3d::Constant(std::max(r, thickness * r));
+            const Eigen::Vector3d box = Eigen::Vector3d::Constant(std::max(r, slack));
             const Index3 lo = lattice.CellOf(p - box), hi = lattice.CellOf(p + box);
             for (int z = lo[2]; z <= hi[2]; ++z)
                 for (int y = lo[1]; y <= hi[1]; ++y)

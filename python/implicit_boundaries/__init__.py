@@ -7,7 +7,7 @@
 
 or, with numpy arrays only, :func:`reconstruct`.
 """
-from ._plugin import FILTER_NAME, load, plugin_path
+from ._plugin import FILTER_NAME, apply, load, plugin_path
 from .reconstruct import Reconstruction, loops_from_result, reconstruct
 
-__all__ = ["FILTER_NAME", "load", "plugin_path", "reconstruct", "Reconstruction", "loops_from_result"]
+__all__ = ["FILTER_NAME", "apply", "load", "plugin_path", "reconstruct", "Reconstruction", "loops_from_result"]

@@ -18,8 +18,27 @@ def plugin_path() -> Path:
     return path
 
 
+def apply(ms: pymeshlab.MeshSet, **kwargs) -> dict:
+    """Runs the filter on ``ms`` (what the bound MeshSet method does); returns its result dictionary.
+
+    When the filter raises, pymeshlab 2025.7 (once any plugin was added with load_plugin) keeps
+    a pointer to this MeshSet's log, and the next mesh loaded after this MeshSet is gone crashes
+    the interpreter. Any filter that succeeds on the same MeshSet clears that pointer, so a cheap
+    measure is run before the error is passed on.
+    """
+    try:
+        return ms.apply_filter(FILTER_NAME, **kwargs)
+    except pymeshlab.PyMeshLabException:
+        if ms.mesh_number() > 0:
+            try:
+                ms.get_topological_measures()
+            except pymeshlab.PyMeshLabException:
+                pass
+        raise
+
+
 def _bound_method(self, **kwargs):
-    return self.apply_filter(FILTER_NAME, **kwargs)
+    return apply(self, **kwargs)
 
 
 def load() -> Path:

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pymeshlab
 
-from ._plugin import FILTER_NAME, load
+from ._plugin import FILTER_NAME, apply, load
 from .reconstruct import loops_from_result
 
 DEMO_SCAN = Path(pymeshlab.__file__).parent / "tests" / "sample_meshes" / "bunny10k_textured.obj"
@@ -22,6 +22,7 @@ def _point_cloud(ms: pymeshlab.MeshSet, path: Path) -> None:
     """Loads `path` and replaces it by its vertices and normals only (faces ignored)."""
     ms.load_new_mesh(str(path))
     m = ms.current_mesh()
+    m.compact()
     points = pymeshlab.Mesh(vertex_matrix=m.vertex_matrix(), v_normals_matrix=m.vertex_normal_matrix())
     ms.clear()
     ms.add_mesh(points, path.stem)
@@ -29,8 +30,11 @@ def _point_cloud(ms: pymeshlab.MeshSet, path: Path) -> None:
 
 def _reconstruct(ms: pymeshlab.MeshSet, args) -> dict:
     load()
-    return ms.apply_filter(FILTER_NAME, resolution=args.resolution, sods_dilation=args.sods_dilation,
-                           normals="Estimate" if args.estimate_normals else "Use layer normals")
+    params = {name: getattr(args, name) for name in ("resolution", "sods_dilation", "sample_radius")
+              if getattr(args, name) is not None}
+    if args.paper_occupancy:
+        params["sods_occupancy"] = "Sample cells (paper)"
+    return apply(ms, normals="Estimate" if args.estimate_normals else "Use layer normals", **params)
 
 
 def _report(result: dict, out: Path) -> None:
@@ -80,8 +84,11 @@ def _parser() -> argparse.ArgumentParser:
     sub = p.add_subparsers(dest="command", required=True)
 
     def options(q):
-        q.add_argument("--resolution", type=int, default=0, help="cells along the longest side (0 = automatic)")
-        q.add_argument("--sods-dilation", type=int, default=1, help="rings of neighbour cells (default 1)")
+        q.add_argument("--resolution", type=int, help="cells along the longest side (default 0: from the sample spacing)")
+        q.add_argument("--sample-radius", type=float, help="tangent disk radius in sample spacings (default 1.25)")
+        q.add_argument("--sods-dilation", type=int, help="rings of neighbour cells added to the SODS (default 0)")
+        q.add_argument("--paper-occupancy", action="store_true",
+                       help="SODS from the cells holding samples, as in the paper (use with --sods-dilation 1)")
         q.add_argument("--estimate-normals", action="store_true", help="ignore the input's normals")
 
     r = sub.add_parser("reconstruct", help="reconstruct a point cloud file into a mesh file")

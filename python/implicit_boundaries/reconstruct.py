@@ -5,7 +5,7 @@ from typing import Dict, List, Optional
 import numpy as np
 import pymeshlab
 
-from ._plugin import FILTER_NAME, load
+from ._plugin import apply, load
 
 NORMALS = {False: "Use layer normals", True: "Estimate"}
 
@@ -36,14 +36,16 @@ def loops_from_result(result: Dict[str, object]) -> List[np.ndarray]:
     return np.split(vertices, np.cumsum(edges)[:-1]) if len(edges) else []
 
 
-def reconstruct(points, normals: Optional[np.ndarray] = None, resolution: int = 0, sods_dilation: int = 1,
-                estimate_normals: bool = False, normal_neighbours: int = 10) -> Reconstruction:
+def reconstruct(points, normals: Optional[np.ndarray] = None, estimate_normals: bool = False,
+                **params) -> Reconstruction:
     """Reconstructs the surface with boundaries of the (n, 3) ``points``.
 
-    normals: (n, 3) outward normals, or None to estimate them. resolution: cells along the
-    longest bounding-box side, 0 = automatic from the sample spacing. sods_dilation: rings of
-    neighbour cells in which the surface may pass without samples. Raises
-    pymeshlab.PyMeshLabException with the filter's message on bad input.
+    normals: (n, 3) outward normals, or None to estimate them (as does estimate_normals=True
+    when normals are given). params: the filter's other parameters by their pymeshlab names,
+    e.g. resolution=128 (cells along the longest bounding-box side; 0, the default, chooses it
+    from the sample spacing), sods_occupancy, sample_radius, sods_dilation, normal_neighbours;
+    ``pymeshlab.print_filter_parameter_list(implicit_boundaries.FILTER_NAME)`` lists them.
+    Raises pymeshlab.PyMeshLabException with the filter's message on bad input.
     """
     load()
     points = np.ascontiguousarray(points, dtype=np.float64).reshape(-1, 3)
@@ -56,8 +58,6 @@ def reconstruct(points, normals: Optional[np.ndarray] = None, resolution: int = 
         mesh = pymeshlab.Mesh(vertex_matrix=points, v_normals_matrix=normals)
     ms = pymeshlab.MeshSet()
     ms.add_mesh(mesh, "points")
-    info = ms.apply_filter(FILTER_NAME, resolution=resolution, sods_dilation=sods_dilation,
-                           normals=NORMALS[bool(estimate_normals)],
-                           normal_neighbours=normal_neighbours)
+    info = apply(ms, normals=NORMALS[bool(estimate_normals)], **params)
     out = ms.current_mesh()
     return Reconstruction(out.vertex_matrix(), out.face_matrix(), loops_from_result(info), dict(info))

@@ -7,10 +7,8 @@
 /// Hoppe et al. take the distance to the plane of the single nearest tangent-plane centre,
 /// which makes the function jump between Voronoi regions of the samples and the extracted
 /// surface jagged. We blend the signed distances to the planes of the k nearest samples with
-/// weights exp(-(d_i^2 - d_1^2) / s^2), d_1 the nearest distance and s the sample spacing:
-/// near the samples this averages the planes of about one spacing around the query (smooth),
-/// and far from them it stays dominated by the nearest planes as in Hoppe et al. (a plain
-/// k-neighbour average there lets planes from other parts of the object create spurious sheets).
+/// Gaussian weights (scale: the distance to the k-th neighbour), which keeps the zero set on
+/// the tangent planes where they agree and makes it continuous where they do not.
 
 #include "implicit_function.h"
 #include "../parallel.h"
@@ -25,11 +23,9 @@ namespace ib {
 class HoppeDistance : public ImplicitFunction
 {
 public:
-    /// P, N: n×3 sample positions and unit outward normals (rows). spacing: the typical sample
-    /// spacing (the blending scale). k: planes blended per query.
-    HoppeDistance(const Points& P, const Points& N, double spacing, int k = 8, int threads = 0)
-        : P_(P), N_(N), inv_scale2_(1 / (spacing * spacing)), k_(std::max(1, std::min<int>(k, int(P.rows())))),
-          threads_(threads)
+    /// P, N: n×3 sample positions and unit outward normals (rows). k: planes blended per query.
+    HoppeDistance(const Points& P, const Points& N, int k = 8, int threads = 0)
+        : P_(P), N_(N), k_(std::max(1, std::min<int>(k, int(P.rows())))), threads_(threads)
     {
         tree_ = std::make_unique<vcg::KdTree<double>>(vcg::ConstDataWrapper<vcg::Point3d>(
             reinterpret_cast<const vcg::Point3d*>(P_.data()), int(P_.rows())));
@@ -49,13 +45,12 @@ private:
     {
         tree_->doQueryK(vcg::Point3d(q[0], q[1], q[2]), k_, queue);
         const int found = queue.getNofElements();
-        double nearest2 = queue.getWeight(0);  // squared distances; the heap's order is not sorted
-        for (int j = 1; j < found; ++j)
-            nearest2 = std::min(nearest2, queue.getWeight(j));
+        // The queue is a max-heap on squared distance: its top is the farthest neighbour.
+        const double scale2 = std::max(queue.getTopWeight(), 1e-300);
         double sum = 0, weights = 0;
         for (int j = 0; j < found; ++j) {
             const int id = queue.getIndex(j);
-            const double w = std::exp(-(queue.getWeight(j) - nearest2) * inv_scale2_);
+            const double w = std::exp(-queue.getWeight(j) / scale2);
             sum += w * (q - P_.row(id).transpose()).dot(N_.row(id).transpose());
             weights += w;
         }
@@ -63,7 +58,6 @@ private:
     }
 
     Points P_, N_;
-    double inv_scale2_;
     int k_;
     int threads_;
     std::unique_ptr<vcg::KdTree<double>> tree_;

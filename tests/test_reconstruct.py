@@ -1,0 +1,53 @@
+"""implicit_boundaries.reconstruct: numpy in, numpy out, on generated geometry."""
+import numpy as np
+import pytest
+
+import implicit_boundaries
+
+
+def fibonacci_sphere(n, radius=1.0):
+    i = np.arange(n) + 0.5
+    z = 1 - 2 * i / n
+    phi = np.pi * (3 - np.sqrt(5)) * i
+    r = np.sqrt(1 - z * z)
+    normals = np.column_stack([r * np.cos(phi), r * np.sin(phi), z])
+    return radius * normals, normals
+
+
+def test_sphere_is_closed_and_on_the_sphere():
+    points, normals = fibonacci_sphere(5000)
+    rec = implicit_boundaries.reconstruct(points, normals)
+    assert rec.loops == []
+    assert rec.faces.shape[1] == 3 and rec.faces.max() < len(rec.vertices)
+    error = np.abs(np.linalg.norm(rec.vertices, axis=1) - 1)
+    assert error.max() < 0.25 * rec.info["cell_size"]
+
+
+def test_hemisphere_has_one_loop_at_its_rim():
+    points, normals = fibonacci_sphere(8000)
+    keep = points[:, 2] >= 0
+    rec = implicit_boundaries.reconstruct(points[keep], normals[keep])
+    assert len(rec.loops) == 1
+    rim = rec.vertices[rec.loops[0]]
+    # The rim is the circle z = 0. The SODS reaches past it by a tangent disk radius (1.25
+    # sample spacings) plus up to a cell; boundary smoothing and trimming come later.
+    reach = 1.25 * rec.info["sample_spacing"] + 2 * rec.info["cell_size"]
+    assert np.all((rim[:, 2] < rec.info["cell_size"]) & (rim[:, 2] > -reach))
+    assert np.all(np.abs(np.hypot(rim[:, 0], rim[:, 1]) - 1) < 0.25 * reach)
+    polyline = rec.loop_polylines()[0]
+    assert np.array_equal(polyline[0], polyline[-1])
+    assert np.linalg.norm(np.diff(polyline, axis=0), axis=1).sum() == pytest.approx(2 * np.pi, rel=0.2)
+
+
+def test_two_disjoint_patches_give_two_loops():
+    points, normals = fibonacci_sphere(12000)
+    caps = np.abs(points[:, 2]) > 0.5  # two polar caps
+    rec = implicit_boundaries.reconstruct(points[caps], normals[caps])
+    assert len(rec.loops) == 2
+    assert sorted(np.sign(rec.vertices[loop][:, 2].mean()) for loop in rec.loops) == [-1, 1]
+
+
+def test_normals_must_match_points():
+    points, normals = fibonacci_sphere(100)
+    with pytest.raises(ValueError, match="one normal per point"):
+        implicit_boundaries.reconstruct(points, normals[:50])
