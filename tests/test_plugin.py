@@ -159,3 +159,24 @@ def test_bad_parameters_raise_clear_errors(plugin, params, message):
     with pytest.raises(pymeshlab.PyMeshLabException, match=message):
         getattr(ms, FILTER)(**params)
     assert ms.mesh_number() == 1
+
+
+def test_filter_script_runs_and_matches_the_filter(plugin, tmp_path):
+    """meshlab_filters.xml (the MeshLab FilterScript at the repository root) runs through
+    pymeshlab, and its parameters are exactly the filter's defaults (fails when they drift)."""
+    import xml.etree.ElementTree as ET
+    from pathlib import Path
+
+    script = Path(__file__).parent.parent / "meshlab_filters.xml"
+    points, normals, _ = point_cloud(SAMPLES / "bunny10k_textured.obj")
+    ms = new_set(points, normals)
+    ms.load_filter_script(str(script))
+    ms.apply_filter_script()
+    assert ms.mesh_number() == 2 and ms.current_mesh().face_number() > 10000
+
+    fresh = new_set(points, normals)
+    getattr(fresh, FILTER)()
+    fresh.save_filter_script(str(tmp_path / "defaults.mlx"))
+    params = lambda path: {(p.get("name"), p.get("type"), p.get("value"))
+                           for p in ET.parse(path).getroot().iter("Param")}
+    assert params(script) == params(tmp_path / "defaults.mlx")
