@@ -5,7 +5,8 @@ import pytest
 from scipy.spatial import cKDTree
 
 import implicit_boundaries
-from conftest import SAMPLES, boundary_loops_of, point_cloud
+from conftest import SAMPLES, point_cloud
+from implicit_boundaries.metrics import boundary_vertex_sets, match_loops
 
 FILTER = implicit_boundaries.FILTER_NAME
 
@@ -50,7 +51,7 @@ def test_bunny_scan_keeps_its_real_holes(plugin):
     automatic resolution the other 3 must come out as loops at the right place, and no large
     boundary may appear anywhere else."""
     points, normals, faces = point_cloud(SAMPLES / "bunny10k_textured.obj")
-    true_holes = boundary_loops_of(faces, len(points))
+    true_holes = boundary_vertex_sets(faces, len(points))
     assert len(true_holes) == 5
     ms = new_set(points, normals)
     result = getattr(ms, FILTER)()
@@ -58,15 +59,10 @@ def test_bunny_scan_keeps_its_real_holes(plugin):
     loops = implicit_boundaries.loops_from_result(result)
     spacing = result["sample_spacing"]
 
-    owner = np.concatenate([[k] * len(h) for k, h in enumerate(true_holes)])
-    tree = cKDTree(points[np.concatenate(true_holes)])
-    found = {}
-    for loop in loops:
-        d, nearest = tree.query(out[loop])
-        if d.mean() < 2.5 * spacing:
-            found.setdefault(owner[nearest[np.argmin(d)]], []).append(len(loop))
-        else:
-            assert len(loop) < 15, f"a {len(loop)}-edge boundary far from every real hole"
+    matched = match_loops([points[h] for h in true_holes], [out[loop] for loop in loops], 2.5 * spacing)
+    found = {k: [len(loops[i]) for i in ids] for k, ids in matched.items()}
+    spurious = set(range(len(loops))) - {i for ids in matched.values() for i in ids}
+    assert all(len(loops[i]) < 15 for i in spurious), "a large boundary far from every real hole"
     print(f"\nresolution {result['resolution']}: {len(loops)} loops, edges {[len(l) for l in loops]}; "
           f"per true hole (edges -> loops found): {[(len(h), found.get(k, [])) for k, h in enumerate(true_holes)]}")
     assert sum(max(v) >= 15 for v in found.values()) >= 3

@@ -1,0 +1,86 @@
+"""Boundary benchmark on the meshes with known boundaries (DESIGN.md section 5, first part).
+
+For each mesh: its vertices and face normals as the input point cloud, reconstructed with our
+defaults (tangent-disk SODS, automatic resolution) and with the paper's SODS (sample cells +
+one 26-ring); reports loops found against the true boundaries, the implicit evaluations
+against a full lattice, and the time against MeshLab's screened Poisson in the same run.
+
+    python bench/boundaries.py [--data DIR] > results.md
+"""
+import argparse
+import time
+from pathlib import Path
+
+import numpy as np
+import pymeshlab
+
+import implicit_boundaries
+from implicit_boundaries.metrics import boundary_vertex_sets, match_loops
+
+DEFAULT_DATA = Path(__file__).resolve().parent.parent.parent / "shared" / "data"
+CASES = ["bun_zipper.ply", "mech-holes-shark.off", "fandisk_truncated.off", "tum_rabbit.ply", "gargoyle.ply"]
+METHODS = {
+    "ours (tangent disks)": {},
+    "paper SODS (cells + 1 ring)": {"sods_occupancy": "Sample cells (paper)", "sods_dilation": 1},
+}
+
+
+def load_case(path):
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(str(path))
+    if ms.current_mesh().face_number() > 0:
+        ms.meshing_remove_unreferenced_vertices()
+        ms.compute_normal_per_vertex()
+    m = ms.current_mesh()
+    m.compact()
+    return m.vertex_matrix().copy(), m.vertex_normal_matrix().copy(), m.face_matrix().copy()
+
+
+def run(points, normals, truth, resolution, params):
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=points, v_normals_matrix=normals), "points")
+    t = time.perf_counter()
+    out = implicit_boundaries.apply(ms, resolution=resolution, **params)
+    seconds = time.perf_counter() - t
+    vertices = ms.current_mesh().vertex_matrix()
+    loops = implicit_boundaries.loops_from_result(out)
+    matched = match_loops(truth, [vertices[l] for l in loops], 2.5 * out["sample_spacing"] + 2 * out["cell_size"])
+    # A true boundary counts as found when its largest assigned loop has at least 10 edges.
+    found = sum(max(len(loops[i]) for i in ids) >= 10 for ids in matched.values())
+    assigned = {i for ids in matched.values() for i in ids}
+    spurious = [len(l) for i, l in enumerate(loops) if i not in assigned]
+    return out, seconds, found, spurious
+
+
+def poisson_seconds(points, normals, resolution):
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=points, v_normals_matrix=normals), "points")
+    t = time.perf_counter()
+    ms.generate_surface_reconstruction_screened_poisson(depth=int(round(np.log2(resolution))))
+    return time.perf_counter() - t
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p.add_argument("--data", type=Path, default=DEFAULT_DATA)
+    args = p.parse_args(argv)
+    implicit_boundaries.load()
+    print("| mesh | samples | true loops | method | resolution | loops | true found | spurious (≥10 edges / all) "
+          "| largest loops | evaluations / full lattice | time / screened Poisson |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    for name in CASES:
+        points, normals, faces = load_case(args.data / name)
+        truth = [points[h] for h in boundary_vertex_sets(faces, len(points))]
+        resolutions = [0, 100] if name == "bun_zipper.ply" else [0]
+        for resolution in resolutions:
+            for method, params in METHODS.items():
+                out, seconds, found, spurious = run(points, normals, truth, resolution, params)
+                ratio = seconds / poisson_seconds(points, normals, out["resolution"])
+                edges = out["boundary_loop_edges"].astype(int).tolist()
+                print(f"| {name} | {len(points)} | {len(truth)} | {method} | {out['resolution']} | {len(edges)} "
+                      f"| {found}/{len(truth)} | {sum(s >= 10 for s in spurious)} / {len(spurious)} | {edges[:6]} "
+                      f"| {out['implicit_evaluations'] / out['full_lattice_evaluations']:.3f} | {ratio:.2f} |")
+
+
+if __name__ == "__main__":
+    main()
