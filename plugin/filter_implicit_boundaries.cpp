@@ -147,6 +147,16 @@ RichParameterList FilterImplicitBoundariesPlugin::reconstructionParameters(const
 		"scans); each ring extends the surface by about one cell across real boundaries and "
 		"closes holes narrower than two cells.",
 		true));
+	par.addParam(RichInt(
+		"min_boundary_edges", d.min_boundary_edges, "Min boundary edges",
+		"A hole whose boundary loop has fewer edges is taken as undersampling and filled with "
+		"its hole triangles (the implicit surface across it); larger holes are kept as real "
+		"boundaries. 0 keeps every hole. Raise it to fill more gaps of a sparse scan; lower it "
+		"to keep small real holes. Counts grow with the resolution."));
+	par.addParam(RichBool(
+		"hole_layer", false, "Hole triangles in their own layer",
+		"Also add a layer '<input> holes' with the triangles that close the kept holes: showing "
+		"both layers gives the closed surface, hiding it the surface with boundaries."));
 	par.addParam(RichEnum(
 		"normals", int(d.normals), kNormalSources, "Normals",
 		"Where the oriented normals that define inside and outside come from. 'Use layer normals' "
@@ -186,13 +196,17 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 	p.sods_dilation = par.getInt("sods_dilation");
 	p.normals = ib::Reconstruction::NormalSource(par.getEnum("normals"));
 	p.normal_neighbours = par.getInt("normal_neighbours");
+	p.min_boundary_edges = par.getInt("min_boundary_edges");
+	const bool holeLayer = par.getBool("hole_layer");
 	p.occupancy = ib::Reconstruction::Occupancy(par.getEnum("sods_occupancy"));
 	p.sample_radius = par.getFloat("sample_radius");
 
-	ib::CoreMesh surface;
+	ib::CoreMesh surface, holes;
 	ib::Reconstruction::Result r;
 	try {
-		r = ib::Reconstruction::Compute(vertexMatrix(input->cm, false), vertexMatrix(input->cm, true), p, surface, cb);
+		r = ib::Reconstruction::Compute(
+			vertexMatrix(input->cm, false), vertexMatrix(input->cm, true), p, surface,
+			holeLayer ? &holes : nullptr, cb);
 	}
 	catch (const ib::InputError& e) {
 		throw MLException(QString("Implicit reconstruction with boundaries: ") + e.what());
@@ -208,6 +222,12 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 		for (int v : loop.vertices)
 			out->cm.vert[v].SetS();
 	out->updateBoxAndNormals();
+	if (holeLayer) {
+		MeshModel* holeModel = md.addNewMesh("", input->label() + " holes", false);
+		vcg::tri::Append<CMeshO, ib::CoreMesh>::MeshCopyConst(holeModel->cm, holes);
+		holeModel->updateBoxAndNormals();
+		md.setCurrentMesh(out->id());
+	}
 
 	std::vector<double> edges, lengths, loopVertices;
 	for (const auto& loop : r.loops) {
@@ -223,16 +243,24 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 	log("Lattice %dx%dx%d, cell %g (resolution %d%s, sample spacing %g).",
 		r.lattice_cells[0], r.lattice_cells[1], r.lattice_cells[2], r.cell_size, r.resolution,
 		r.resolution_automatic ? ", automatic" : "", r.sample_spacing);
-	log("Surface: %d faces, %d vertices; %d boundary loops (edges: %s); %zu SODS cells, "
-		"%zu implicit evaluations instead of %.0f for the full lattice.",
+	log("Surface: %d faces, %d vertices; %d boundary loops kept (edges: %s); %d small holes "
+		"filled (loops under %d edges).",
 		out->cm.fn, out->cm.vn, int(r.loops.size()), qUtf8Printable(loopSummary(r.loops)),
-		r.sods_cells, r.evaluations, r.lattice_corners);
+		r.holes_filled, p.min_boundary_edges);
+	log("%zu SODS cells, %zu hole cells%s; %zu implicit evaluations instead of %.0f for the full "
+		"lattice.",
+		r.sods_cells, r.hole_cells, r.hole_search_capped ? " (search capped: larger holes kept open)" : "",
+		r.evaluations, r.lattice_corners);
 
 	std::map<std::string, QVariant> res;
 	res["boundary_loops"] = int(r.loops.size());
 	res["boundary_loop_edges"] = QVariant::fromValue(toVector(edges));
 	res["boundary_loop_lengths"] = QVariant::fromValue(toVector(lengths));
 	res["boundary_loop_vertices"] = QVariant::fromValue(toVector(loopVertices));
+	res["boundary_loops_before_filling"] = QVariant::fromValue(toVector(
+		std::vector<double>(r.loops_before_filling.begin(), r.loops_before_filling.end())));
+	res["holes_filled"] = r.holes_filled;
+	res["hole_cells"] = double(r.hole_cells);
 	res["surface_faces"] = out->cm.fn;
 	res["surface_vertices"] = out->cm.vn;
 	res["resolution"] = r.resolution;

@@ -1,8 +1,9 @@
 #pragma once
 /// \file boundaries.h
-/// Boundary loops of an extracted surface: the edges used by exactly one face, grouped into
-/// connected components (paper §3.3: "each boundary is a connected component"), each traced
-/// as one closed vertex cycle following the faces' orientation.
+/// Boundary loops of an extracted surface (paper §3.3): edges used by one surface face, each
+/// connected component traced as one closed vertex cycle following the faces' orientation.
+/// With hole triangles present, a boundary edge is one shared by a surface face and a hole
+/// face, and each loop knows the hole faces across it.
 
 #include "mesh.h"
 
@@ -17,6 +18,7 @@ namespace ib {
 struct BoundaryLoop
 {
     std::vector<int> vertices;  ///< closed cycle of vertex indices (first not repeated at the end)
+    std::vector<int> across;    ///< per edge vertices[i] -> vertices[i+1]: the face beyond it, or -1
     double length = 0;          ///< sum of its edge lengths
     int Edges() const { return int(vertices.size()); }
 };
@@ -24,35 +26,45 @@ struct BoundaryLoop
 class BoundaryLoops
 {
 public:
-    /// Loops of `mesh` (no deleted elements), longest first by edge count, ties by first vertex.
-    /// A loop that touches itself or another loop at a vertex is one component and is traced
-    /// as one closed walk (Hierholzer), so every boundary edge appears in exactly one loop.
-    static std::vector<BoundaryLoop> Compute(const CoreMesh& mesh)
+    /// Loops of the faces f of `mesh` with surface[f] != 0 (every face when `surface` is empty),
+    /// largest first by edge count. A loop that touches itself or another loop at a vertex is
+    /// one component and is traced as one closed walk (Hierholzer), so every boundary edge is
+    /// in exactly one loop.
+    static std::vector<BoundaryLoop> Compute(const CoreMesh& mesh, const std::vector<char>& surface = {})
     {
-        // Directed half-edges a->b of each face; a boundary edge has no opposite b->a.
-        std::unordered_map<uint64_t, int> halfedges;
+        auto inSurface = [&](size_t f) { return surface.empty() || surface[f]; };
         auto key = [](uint64_t a, uint64_t b) { return a << 32 | b; };
-        for (const auto& f : mesh.face)
+        // Directed half-edges a->b of every face, with the face that owns them.
+        std::unordered_map<uint64_t, int> owner;
+        owner.reserve(mesh.face.size() * 3);
+        for (size_t f = 0; f < mesh.face.size(); ++f)
             for (int i = 0; i < 3; ++i)
-                ++halfedges[key(vcg::tri::Index(mesh, f.cV(i)), vcg::tri::Index(mesh, f.cV((i + 1) % 3)))];
+                owner.emplace(key(vcg::tri::Index(mesh, mesh.face[f].cV(i)), vcg::tri::Index(mesh, mesh.face[f].cV((i + 1) % 3))),
+                              int(f));
 
-        // Outgoing boundary edges per vertex, sorted for a deterministic walk.
-        std::map<int, std::vector<int>> out;
-        for (const auto& [k, count] : halfedges) {
-            const int a = int(k >> 32), b = int(k & 0xffffffffu);
-            if (!halfedges.count(key(uint64_t(b), uint64_t(a))))
-                for (int c = 0; c < count; ++c)
-                    out[a].push_back(b);
+        // Outgoing boundary edges per vertex (target, face across), sorted for a deterministic walk.
+        std::map<int, std::vector<std::pair<int, int>>> out;
+        for (size_t f = 0; f < mesh.face.size(); ++f) {
+            if (!inSurface(f))
+                continue;
+            for (int i = 0; i < 3; ++i) {
+                const int a = int(vcg::tri::Index(mesh, mesh.face[f].cV(i)));
+                const int b = int(vcg::tri::Index(mesh, mesh.face[f].cV((i + 1) % 3)));
+                auto opposite = owner.find(key(uint64_t(b), uint64_t(a)));
+                if (opposite == owner.end())
+                    out[a].emplace_back(b, -1);
+                else if (!inSurface(size_t(opposite->second)))
+                    out[a].emplace_back(b, opposite->second);
+            }
         }
         for (auto& [v, targets] : out)
-            std::sort(targets.begin(), targets.end(), std::greater<int>());
+            std::sort(targets.begin(), targets.end(), std::greater<>());
 
         std::vector<BoundaryLoop> loops;
         for (auto& [start, targets] : out) {
             if (targets.empty())
                 continue;
-            BoundaryLoop loop;
-            loop.vertices = Circuit(start, out);
+            BoundaryLoop loop = Circuit(start, out);
             const size_t n = loop.vertices.size();
             for (size_t i = 0; i < n; ++i)
                 loop.length += vcg::Distance(mesh.vert[loop.vertices[i]].cP(), mesh.vert[loop.vertices[(i + 1) % n]].cP());
@@ -67,11 +79,11 @@ private:
     /// Closed walk using every boundary edge reachable from `start`; consumes them from `out`.
     /// Directed boundary edges of an oriented surface enter and leave each vertex equally often,
     /// so such a walk exists.
-    static std::vector<int> Circuit(int start, std::map<int, std::vector<int>>& out)
+    static BoundaryLoop Circuit(int start, std::map<int, std::vector<std::pair<int, int>>>& out)
     {
-        std::vector<int> stack{start}, circuit;
+        std::vector<std::pair<int, int>> stack{{start, -1}}, circuit;  // (vertex, face across the edge into it)
         while (!stack.empty()) {
-            std::vector<int>& targets = out[stack.back()];
+            auto& targets = out[stack.back().first];
             if (targets.empty()) {
                 circuit.push_back(stack.back());
                 stack.pop_back();
@@ -80,9 +92,14 @@ private:
                 targets.pop_back();
             }
         }
+        // circuit is the walk backwards: circuit[i] was entered from circuit[i+1] across circuit[i].second.
         std::reverse(circuit.begin(), circuit.end());
-        circuit.pop_back();  // the walk ends where it started
-        return circuit;
+        BoundaryLoop loop;
+        for (size_t i = 0; i + 1 < circuit.size(); ++i) {
+            loop.vertices.push_back(circuit[i].first);
+            loop.across.push_back(circuit[i + 1].second);
+        }
+        return loop;
     }
 };
 

@@ -1,11 +1,19 @@
 #pragma once
 /// \file gated_mc.h
-/// Marching cubes gated by the SODS (paper §3.2): triangles are extracted only in SODS
-/// cells, and the implicit function is evaluated only at the corners of those cells
-/// (the "SODS-driven" extraction the paper proposes in §3.4; cost Θ(k) in the number of
-/// SODS cells instead of Θ(m) in the lattice size). Uses VCGlib's topologically consistent
-/// vcg::tri::MarchingCubes tables with our own walker, which serves corner values from one
-/// batch evaluation and welds every edge vertex shared by neighbouring cells.
+/// Marching cubes gated by the SODS (paper §3.2) and the hole triangles (paper §3.3).
+///
+/// Surface triangles are extracted only in SODS cells, evaluating the implicit function only
+/// at the corners of those cells (the "SODS-driven" extraction of paper §3.4: Θ(k) in the
+/// number of SODS cells instead of Θ(m) in the lattice size). Hole triangles are then found by
+/// a breadth-first search from the empty cells next to SODS cells through empty cells that the
+/// implicit surface crosses; they are extracted with the same walker, so they share vertices
+/// with the surface and surface + holes is the closed marching cubes surface. Each connected
+/// set of hole cells is a hole region; a region is closed when the search finished it away
+/// from the lattice border (the implicit surface closes it), open otherwise (the surface runs
+/// off, as at a cut, or the search hit its cap).
+///
+/// Uses VCGlib's topologically consistent vcg::tri::MarchingCubes tables with our own walker,
+/// which serves corner values from batch evaluations and welds the edge vertices of neighbours.
 
 #include "implicit/implicit_function.h"
 #include "mesh.h"
@@ -13,73 +21,226 @@
 
 #include <vcg/complex/algorithms/create/marching_cubes.h>
 
+#include <array>
 #include <unordered_map>
+#include <unordered_set>
 
 namespace ib {
 
 class GatedMarchingCubes
 {
 public:
-    struct Stats
+    struct Param
     {
-        size_t cells = 0;        ///< SODS cells visited
-        size_t evaluations = 0;  ///< implicit function evaluations
+        bool holes = true;           ///< also extract the hole triangles
+        size_t max_hole_cells = 0;   ///< cap of the hole search; 0 = max(SODS cells, 4096)
     };
 
-    /// Extracts into `mesh` (cleared first) the zero set of f inside the cells of `sods`.
-    /// Faces are oriented with their normals towards positive values of f.
-    static Stats Compute(const Lattice& lattice, const Sods& sods, const ImplicitFunction& f,
-                         CoreMesh& mesh, vcg::CallBackPos* cb = nullptr)
+    /// What Compute made besides the mesh. Faces [0, surface_faces) lie in SODS cells; face
+    /// surface_faces + i lies in hole region face_region[i].
+    struct Result
     {
-        Stats stats;
+        size_t surface_faces = 0;
+        std::vector<int> face_region;
+        std::vector<char> region_closed;  ///< per hole region
+        size_t sods_cells = 0, hole_cells = 0, evaluations = 0;
+        bool hole_search_capped = false;
+    };
+
+    /// Extracts into `mesh` (cleared first) the zero set of f inside the cells of `sods`, then
+    /// (param.holes) in the hole cells. Faces point towards positive values of f.
+    static Result Compute(const Lattice& lattice, const Sods& sods, const ImplicitFunction& f, CoreMesh& mesh,
+                          const Param& param, vcg::CallBackPos* cb = nullptr)
+    {
+        Result r;
+        CornerValues values(lattice, f);
         const std::vector<Index3> cells = sods.Cells();
-        stats.cells = cells.size();
-
-        // Unique corners of the SODS cells, in sorted key order (deterministic).
-        std::vector<uint64_t> keys;
-        keys.reserve(cells.size() * 8);
-        for (const Index3& c : cells)
-            for (int corner = 0; corner < 8; ++corner)
-                keys.push_back(PackIndex(c[0] + (corner & 1), c[1] + ((corner >> 1) & 1), c[2] + (corner >> 2)));
-        std::sort(keys.begin(), keys.end());
-        keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
-
-        Points Q(keys.size(), 3);
-        for (size_t i = 0; i < keys.size(); ++i) {
-            const Index3 v = UnpackIndex(keys[i]);
-            Q.row(Eigen::Index(i)) = lattice.Corner(v[0], v[1], v[2]).transpose();
-        }
+        r.sods_cells = cells.size();
         if (cb) cb(10, "Evaluating the implicit function at SODS corners");
-        Eigen::VectorXd values(Q.rows());
-        f.Eval(Q, values);
-        stats.evaluations = size_t(Q.rows());
+        values.Evaluate(cells);
 
-        Walker walker(lattice, mesh, keys, values);
+        Walker walker(lattice, mesh, values);
         vcg::tri::MarchingCubes<CoreMesh, Walker> mc(mesh, walker);
         mc.Initialize();
         const size_t step = std::max<size_t>(1, cells.size() / 20);
         for (size_t i = 0; i < cells.size(); ++i) {
-            const Index3& c = cells[i];
-            mc.ProcessCell(vcg::Point3i(c[0], c[1], c[2]), vcg::Point3i(c[0] + 1, c[1] + 1, c[2] + 1));
-            if (cb && i % step == 0) cb(60 + int(40 * i / cells.size()), "Marching cubes over SODS cells");
+            Process(mc, cells[i]);
+            if (cb && i % step == 0) cb(60 + int(30 * i / cells.size()), "Marching cubes over SODS cells");
+        }
+        r.surface_faces = mesh.face.size();
+
+        if (param.holes) {
+            if (cb) cb(90, "Searching hole triangles");
+            const size_t cap = param.max_hole_cells ? param.max_hole_cells : std::max<size_t>(cells.size(), 4096);
+            HoleSearch search(lattice, sods, values, cells, cap);
+            r.hole_cells = search.cells.size();
+            r.hole_search_capped = search.capped;
+            r.region_closed = search.closed;
+            for (size_t i = 0; i < search.cells.size(); ++i) {
+                const size_t before = mesh.face.size();
+                Process(mc, search.cells[i]);
+                r.face_region.insert(r.face_region.end(), mesh.face.size() - before, search.region[i]);
+            }
         }
         mc.Finalize();
-        return stats;
+        r.evaluations = values.Count();
+        return r;
+    }
+
+    /// Compute with the default Param (surface and holes).
+    static Result Compute(const Lattice& lattice, const Sods& sods, const ImplicitFunction& f, CoreMesh& mesh)
+    {
+        return Compute(lattice, sods, f, mesh, Param());
     }
 
 private:
-    /// Serves VCG's MarchingCubes: corner values from the batch, edge vertices welded by edge key.
+    template <class MarchingCubes>
+    static void Process(MarchingCubes& mc, const Index3& c)
+    {
+        mc.ProcessCell(vcg::Point3i(c[0], c[1], c[2]), vcg::Point3i(c[0] + 1, c[1] + 1, c[2] + 1));
+    }
+
+    static std::array<uint64_t, 8> CornerKeys(const Index3& c)
+    {
+        std::array<uint64_t, 8> k;
+        for (int i = 0; i < 8; ++i)
+            k[i] = PackIndex(c[0] + (i & 1), c[1] + ((i >> 1) & 1), c[2] + (i >> 2));
+        return k;
+    }
+
+    /// Implicit function values at lattice corners, evaluated in batches, each corner once.
+    class CornerValues
+    {
+    public:
+        CornerValues(const Lattice& l, const ImplicitFunction& f) : lattice_(l), f_(f) {}
+
+        /// Evaluates the corners of `cells` that have no value yet (one batch call).
+        void Evaluate(const std::vector<Index3>& cells)
+        {
+            std::vector<uint64_t> keys;
+            keys.reserve(cells.size() * 8);
+            for (const Index3& c : cells)
+                for (uint64_t k : CornerKeys(c))
+                    if (!values_.count(k))
+                        keys.push_back(k);
+            std::sort(keys.begin(), keys.end());
+            keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+            Points Q(keys.size(), 3);
+            for (size_t i = 0; i < keys.size(); ++i) {
+                const Index3 v = UnpackIndex(keys[i]);
+                Q.row(Eigen::Index(i)) = lattice_.Corner(v[0], v[1], v[2]).transpose();
+            }
+            Eigen::VectorXd out(Q.rows());
+            f_.Eval(Q, out);
+            values_.reserve(values_.size() + keys.size());
+            for (size_t i = 0; i < keys.size(); ++i)
+                values_.emplace(keys[i], out[Eigen::Index(i)]);
+        }
+
+        double operator()(uint64_t key) const { return values_.at(key); }
+
+        /// True when the surface crosses cell c (its corners are not all on one side).
+        bool Crossed(const Index3& c) const
+        {
+            int positive = 0;
+            for (uint64_t k : CornerKeys(c))
+                positive += (*this)(k) > 0;
+            return positive != 0 && positive != 8;
+        }
+
+        size_t Count() const { return values_.size(); }
+
+    private:
+        const Lattice& lattice_;
+        const ImplicitFunction& f_;
+        std::unordered_map<uint64_t, double> values_;
+    };
+
+    /// Breadth-first search of the hole cells, level by level so that each level's new corners
+    /// are evaluated in one batch; then their grouping into regions.
+    struct HoleSearch
+    {
+        std::vector<Index3> cells;  ///< hole cells, sorted by key
+        std::vector<int> region;    ///< region of each cell
+        std::vector<char> closed;   ///< per region
+        bool capped = false;
+
+        HoleSearch(const Lattice& lattice, const Sods& sods, CornerValues& values, const std::vector<Index3>& sodsCells,
+                   size_t cap)
+        {
+            static const Index3 kSteps[6] = {Index3(1, 0, 0), Index3(-1, 0, 0), Index3(0, 1, 0),
+                                             Index3(0, -1, 0), Index3(0, 0, 1), Index3(0, 0, -1)};
+            std::unordered_set<uint64_t> queued, examined, holes;
+            std::vector<Index3> frontier;
+            auto enqueue = [&](const Index3& c, std::vector<Index3>& into) {
+                for (const Index3& s : kSteps) {
+                    const Index3 n = c + s;
+                    if (lattice.ContainsCell(n) && !sods.Contains(n) && queued.insert(Key(n)).second)
+                        into.push_back(n);
+                }
+            };
+            for (const Index3& c : sodsCells)
+                enqueue(c, frontier);
+            while (!frontier.empty() && !capped) {
+                values.Evaluate(frontier);
+                std::vector<Index3> next;
+                for (const Index3& c : frontier) {
+                    examined.insert(Key(c));
+                    if (!values.Crossed(c))
+                        continue;
+                    holes.insert(Key(c));
+                    if (holes.size() >= cap) {
+                        capped = true;
+                        break;
+                    }
+                    enqueue(c, next);
+                }
+                frontier.swap(next);
+            }
+
+            std::vector<uint64_t> keys(holes.begin(), holes.end());
+            std::sort(keys.begin(), keys.end());
+            std::unordered_map<uint64_t, int> label;
+            for (uint64_t seed : keys) {
+                if (label.count(seed))
+                    continue;
+                const int id = int(closed.size());
+                closed.push_back(1);
+                std::vector<uint64_t> stack{seed};
+                label[seed] = id;
+                while (!stack.empty()) {
+                    const Index3 c = UnpackIndex(stack.back());
+                    stack.pop_back();
+                    for (const Index3& s : kSteps) {
+                        const Index3 n = c + s;
+                        // Open: the surface leaves the lattice, or goes where the search did not look.
+                        if (!lattice.ContainsCell(n) || (!sods.Contains(n) && !examined.count(Key(n))))
+                            closed[id] = 0;
+                        if (lattice.ContainsCell(n) && holes.count(Key(n)) && label.emplace(Key(n), id).second)
+                            stack.push_back(Key(n));
+                    }
+                }
+            }
+            cells.resize(keys.size());
+            region.resize(keys.size());
+            for (size_t i = 0; i < keys.size(); ++i) {
+                cells[i] = UnpackIndex(keys[i]);
+                region[i] = label[keys[i]];
+            }
+        }
+
+        static uint64_t Key(const Index3& c) { return PackIndex(c[0], c[1], c[2]); }
+    };
+
+    /// Serves VCG's MarchingCubes: corner values from CornerValues, edge vertices welded by edge key.
     class Walker
     {
     public:
-        Walker(const Lattice& l, CoreMesh& m, const std::vector<uint64_t>& keys, const Eigen::VectorXd& values)
-            : lattice_(l), mesh_(m), keys_(keys), values_(values)
-        {
-        }
+        Walker(const Lattice& l, CoreMesh& m, const CornerValues& values) : lattice_(l), mesh_(m), values_(values) {}
 
         /// Served as is, f gives faces whose normals point to f > 0 (outside); VCG's tables take
         /// f > 0 as the corner's "set" state.
-        double V(int x, int y, int z) const { return Value(PackIndex(x, y, z)); }
+        double V(int x, int y, int z) const { return values_(PackIndex(x, y, z)); }
 
         void GetXIntercept(const vcg::Point3i& a, const vcg::Point3i& b, CoreVertex*& v) { v = Intercept(a, b, 0); }
         void GetYIntercept(const vcg::Point3i& a, const vcg::Point3i& b, CoreVertex*& v) { v = Intercept(a, b, 1); }
@@ -95,20 +256,12 @@ private:
         }
 
     private:
-        double Value(uint64_t key) const
-        {
-            auto it = std::lower_bound(keys_.begin(), keys_.end(), key);
-            assert(it != keys_.end() && *it == key);
-            return values_[it - keys_.begin()];
-        }
-
         CoreVertex* Intercept(const vcg::Point3i& a, const vcg::Point3i& b, int axis)
         {
             const uint64_t ka = PackIndex(a[0], a[1], a[2]), kb = PackIndex(b[0], b[1], b[2]);
-            const uint64_t lo = std::min(ka, kb);
-            auto [it, fresh] = edges_.try_emplace(lo << 2 | uint64_t(axis), mesh_.vert.size());
+            auto [it, fresh] = edges_.try_emplace(std::min(ka, kb) << 2 | uint64_t(axis), mesh_.vert.size());
             if (fresh) {
-                const double fa = Value(ka), fb = Value(kb);
+                const double fa = values_(ka), fb = values_(kb);
                 const double t = fa / (fa - fb);
                 const Eigen::Vector3d pa = lattice_.Corner(a[0], a[1], a[2]), pb = lattice_.Corner(b[0], b[1], b[2]);
                 const Eigen::Vector3d p = pa + t * (pb - pa);
@@ -120,8 +273,7 @@ private:
 
         const Lattice& lattice_;
         CoreMesh& mesh_;
-        const std::vector<uint64_t>& keys_;
-        const Eigen::VectorXd& values_;
+        const CornerValues& values_;
         std::unordered_map<uint64_t, size_t> edges_;
     };
 };

@@ -55,11 +55,63 @@ TEST(GatedMarchingCubes, EmitsTrianglesOnlyInSodsCells)
             upper.Insert(c);
     });
     CoreMesh m;
-    GatedMarchingCubes::Compute(l, upper, test::SphereDistance(1.0), m);
+    GatedMarchingCubes::Param noHoles;
+    noHoles.holes = false;
+    GatedMarchingCubes::Compute(l, upper, test::SphereDistance(1.0), m, noHoles);
     ASSERT_GT(m.fn, 0);
     for (const auto& f : m.face)
         EXPECT_GT(vcg::Barycenter(f)[2], 0.3 - l.cell_size);
     const auto t = test::Check(m);
     EXPECT_EQ(t.non_manifold_edges, 0);
     EXPECT_GT(t.border_edges, 0);  // a spherical cap: open
+}
+
+TEST(GatedMarchingCubes, HoleTrianglesCloseTheSurfaceAndShareItsVertices)
+{
+    // SODS: cells whose centre is above z = 0.3 and outside a small cylinder around the z axis,
+    // so the cap gets two holes: the big bottom opening and a small one at the top.
+    const Lattice l = Lattice::Fit(Eigen::Vector3d(-1, -1, -1), Eigen::Vector3d(1, 1, 1), 20, 2);
+    Sods gated(l.cells);
+    AllCells(l).ForEach([&](const Index3& c) {
+        const Eigen::Vector3d centre = l.Corner(c[0], c[1], c[2]) + Eigen::Vector3d::Constant(0.5 * l.cell_size);
+        if (centre[2] > 0.3 && centre.head<2>().norm() > 0.25)
+            gated.Insert(c);
+    });
+    CoreMesh m;
+    const auto r = GatedMarchingCubes::Compute(l, gated, test::SphereDistance(1.0), m);
+    ASSERT_GT(r.surface_faces, 0u);
+    ASSERT_EQ(r.face_region.size(), m.face.size() - r.surface_faces);
+    ASSERT_EQ(r.region_closed.size(), 2u);  // the two holes
+    EXPECT_TRUE(r.region_closed[0] && r.region_closed[1]);
+    EXPECT_FALSE(r.hole_search_capped);
+    // Surface + holes: the closed sphere, one vertex per crossed lattice edge.
+    const auto t = test::Check(m);
+    EXPECT_EQ(t.border_edges, 0);
+    EXPECT_EQ(t.non_manifold_edges, 0);
+    EXPECT_TRUE(t.oriented);
+    EXPECT_EQ(m.vn - (3 * m.fn) / 2 + m.fn, 2);
+    // Hole cells are outside the SODS and only where the surface is.
+    EXPECT_GT(r.hole_cells, 0u);
+    EXPECT_LT(r.evaluations, size_t(l.CornerCount()));
+}
+
+TEST(GatedMarchingCubes, HoleRegionReachingTheLatticeBorderIsOpen)
+{
+    // A plane z = 0.1 through the whole lattice, SODS only in the middle: the hole region
+    // around it runs to the lattice border.
+    class Plane : public ImplicitFunction
+    {
+    public:
+        void Eval(const Points& Q, Eigen::Ref<Eigen::VectorXd> v) const override { v = Q.col(2).array() - 0.1; }
+    };
+    const Lattice l = Lattice::Fit(Eigen::Vector3d(-1, -1, -1), Eigen::Vector3d(1, 1, 1), 12, 1);
+    Sods middle(l.cells);
+    AllCells(l).ForEach([&](const Index3& c) {
+        if ((l.Corner(c[0], c[1], c[2]) + Eigen::Vector3d::Constant(0.5 * l.cell_size)).norm() < 0.5)
+            middle.Insert(c);
+    });
+    CoreMesh m;
+    const auto r = GatedMarchingCubes::Compute(l, middle, Plane(), m);
+    ASSERT_EQ(r.region_closed.size(), 1u);
+    EXPECT_FALSE(r.region_closed[0]);
 }
