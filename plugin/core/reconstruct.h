@@ -123,8 +123,10 @@ public:
 
         t = Clock::now();
         if (cb) cb(5, "Building the implicit function");
-        r.sample_spacing = SampleSpacing::Median(P, p.threads);
-        HoppeDistance f(P, normals, p.hoppe_neighbours, p.threads);
+        const SampleIndex samples(P);
+        const Eigen::VectorXd spacing = SampleSpacing::Local(samples, 1, p.threads);
+        r.sample_spacing = SampleSpacing::Median(spacing);
+        HoppeDistance f(samples, normals, p.hoppe_neighbours, p.threads);
         r.seconds_implicit = seconds(t);
 
         t = Clock::now();
@@ -143,7 +145,7 @@ public:
         r.lattice_corners = lattice.CornerCount();
         if (cb) cb(8, "Building the spatial occupancy data structure");
         Sods sods = p.occupancy == Occupancy::TangentDisks
-                        ? Sods::FromDisks(lattice, P, normals, p.sample_radius * SampleSpacing::Local(P, 1, p.threads),
+                        ? Sods::FromDisks(lattice, P, normals, p.sample_radius * spacing,
                                           kDiskSlack * lattice.cell_size)
                         : Sods::FromSamples(lattice, P);
         for (int i = 0; i < p.sods_dilation; ++i)

@@ -12,38 +12,33 @@
 
 #include "implicit_function.h"
 #include "../parallel.h"
-
-#include <vcg/space/index/kdtree/kdtree.h>
-
-#include <memory>
-#include <vector>
+#include "../samples.h"
 
 namespace ib {
 
 class HoppeDistance : public ImplicitFunction
 {
 public:
-    /// P, N: n×3 sample positions and unit outward normals (rows). k: planes blended per query.
-    HoppeDistance(const Points& P, const Points& N, int k = 8, int threads = 0)
-        : P_(P), N_(N), k_(std::max(1, std::min<int>(k, int(P.rows())))), threads_(threads)
+    /// samples: the sample positions; N: n×3 unit outward normals (rows), kept by reference.
+    /// k: planes blended per query.
+    HoppeDistance(const SampleIndex& samples, const Points& N, int k = 8, int threads = 0)
+        : samples_(samples), N_(N), k_(std::max(1, std::min<int>(k, int(samples.Size())))), threads_(threads)
     {
-        tree_ = std::make_unique<vcg::KdTree<double>>(vcg::ConstDataWrapper<vcg::Point3d>(
-            reinterpret_cast<const vcg::Point3d*>(P_.data()), int(P_.rows())));
     }
 
     void Eval(const Points& Q, Eigen::Ref<Eigen::VectorXd> values) const override
     {
         ParallelFor(size_t(Q.rows()), threads_, [&](size_t begin, size_t end, int) {
-            vcg::KdTree<double>::PriorityQueue queue;
+            SampleIndex::Queue queue;
             for (size_t i = begin; i < end; ++i)
                 values[Eigen::Index(i)] = EvalOne(Q.row(Eigen::Index(i)).transpose(), queue);
         });
     }
 
 private:
-    double EvalOne(const Eigen::Vector3d& q, vcg::KdTree<double>::PriorityQueue& queue) const
+    double EvalOne(const Eigen::Vector3d& q, SampleIndex::Queue& queue) const
     {
-        tree_->doQueryK(vcg::Point3d(q[0], q[1], q[2]), k_, queue);
+        samples_.Nearest(q, k_, queue);
         const int found = queue.getNofElements();
         // The queue is a max-heap on squared distance: its top is the farthest neighbour.
         const double scale2 = std::max(queue.getTopWeight(), 1e-300);
@@ -51,16 +46,16 @@ private:
         for (int j = 0; j < found; ++j) {
             const int id = queue.getIndex(j);
             const double w = std::exp(-queue.getWeight(j) / scale2);
-            sum += w * (q - P_.row(id).transpose()).dot(N_.row(id).transpose());
+            sum += w * (q - samples_.P().row(id).transpose()).dot(N_.row(id).transpose());
             weights += w;
         }
         return sum / weights;
     }
 
-    Points P_, N_;
+    const SampleIndex& samples_;
+    const Points& N_;
     int k_;
     int threads_;
-    std::unique_ptr<vcg::KdTree<double>> tree_;
 };
 
 } // namespace ib
