@@ -153,6 +153,17 @@ RichParameterList FilterImplicitBoundariesPlugin::reconstructionParameters(const
 		"its hole triangles (the implicit surface across it); larger holes are kept as real "
 		"boundaries. 0 keeps every hole. Raise it to fill more gaps of a sparse scan; lower it "
 		"to keep small real holes. Counts grow with the resolution."));
+	par.addParam(RichInt(
+		"boundary_smoothing", d.boundary_smoothing, "Boundary smoothing (iterations)",
+		"Passes of the paper's collinearity moves along each boundary loop, after which the "
+		"boundary is put back on the implicit surface (moves that would fold a face are undone). "
+		"Marching cubes boundaries are jagged; 4 to 6 passes make them smooth. 0 = off."));
+	par.addParam(RichFloat(
+		"boundary_trim", d.boundary_trim, "Boundary trim (spacings)",
+		"Faces at the boundary farther than this many local sample spacings from every sample "
+		"are peeled off, removing the margin the occupancy adds past the scan's edge. Lower it "
+		"to cut tighter (below 0.6 it may bite into sparse regions); 0 = no trim.",
+		true));
 	par.addParam(RichBool(
 		"hole_layer", false, "Hole triangles in their own layer",
 		"Also add a layer '<input> holes' with the triangles that close the kept holes: showing "
@@ -197,6 +208,8 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 	p.normals = ib::Reconstruction::NormalSource(par.getEnum("normals"));
 	p.normal_neighbours = par.getInt("normal_neighbours");
 	p.min_boundary_edges = par.getInt("min_boundary_edges");
+	p.boundary_trim = par.getFloat("boundary_trim");
+	p.boundary_smoothing = par.getInt("boundary_smoothing");
 	const bool holeLayer = par.getBool("hole_layer");
 	p.occupancy = ib::Reconstruction::Occupancy(par.getEnum("sods_occupancy"));
 	p.sample_radius = par.getFloat("sample_radius");

@@ -65,14 +65,22 @@ public:
             if (targets.empty())
                 continue;
             BoundaryLoop loop = Circuit(start, out);
-            const size_t n = loop.vertices.size();
-            for (size_t i = 0; i < n; ++i)
-                loop.length += vcg::Distance(mesh.vert[loop.vertices[i]].cP(), mesh.vert[loop.vertices[(i + 1) % n]].cP());
+            loop.length = Length(mesh, loop);
             loops.push_back(std::move(loop));
         }
         std::stable_sort(loops.begin(), loops.end(),
                          [](const BoundaryLoop& a, const BoundaryLoop& b) { return a.Edges() > b.Edges(); });
         return loops;
+    }
+
+    /// Sum of the edge lengths of `loop` in `mesh`.
+    static double Length(const CoreMesh& mesh, const BoundaryLoop& loop)
+    {
+        double length = 0;
+        const size_t n = loop.vertices.size();
+        for (size_t i = 0; i < n; ++i)
+            length += vcg::Distance(mesh.vert[size_t(loop.vertices[i])].cP(), mesh.vert[size_t(loop.vertices[(i + 1) % n])].cP());
+        return length;
     }
 
 private:

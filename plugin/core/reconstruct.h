@@ -5,6 +5,8 @@
 /// Throws ib::InputError, with a message that says what is wrong and what to do, on bad input.
 
 #include "boundaries.h"
+#include "boundary_smoothing.h"
+#include "boundary_trim.h"
 #include "gated_mc.h"
 #include "implicit/hoppe.h"
 #include "normals.h"
@@ -71,6 +73,10 @@ public:
         /// Holes whose loops all have fewer edges are undersampling: their hole triangles are
         /// added to the surface (paper §3.1). 0 keeps every hole.
         int min_boundary_edges = kDefaultMinBoundaryEdges;
+        /// Faces at the boundary farther than this many local spacings from every sample are
+        /// peeled off (the margin the SODS adds past the scan's edge). 0 = no trim.
+        double boundary_trim = 0.6;
+        int boundary_smoothing = 4;  ///< iterations of collinearity moves (paper §3.3), 0 = off
         int threads = 0;             ///< 0 = all cores
     };
 
@@ -79,6 +85,7 @@ public:
         std::vector<BoundaryLoop> loops;  ///< boundary loops of the surface, largest first
         std::vector<int> loops_before_filling;  ///< edge counts of all loops before small holes were filled
         int holes_filled = 0;             ///< hole regions added to the surface
+        size_t faces_trimmed = 0;         ///< unsupported faces peeled off the boundary
         size_t hole_cells = 0;
         bool hole_search_capped = false;
         int resolution = 0;
@@ -170,6 +177,13 @@ public:
             if (fill[size_t(mc.face_region[face - mc.surface_faces])])
                 inSurface[face] = 1;
         r.holes_filled = int(std::count(fill.begin(), fill.end(), 1));
+        if (p.boundary_trim > 0)
+            r.faces_trimmed = BoundaryTrim::Compute(all, samples, p.boundary_trim * spacing, inSurface, p.threads);
+        // Smoothed on the whole extraction, so the hole triangles follow the boundary.
+        BoundarySmoothing::Param sp;
+        sp.iterations = p.boundary_smoothing;
+        sp.cell_size = lattice.cell_size;
+        BoundarySmoothing::Compute(all, BoundaryLoops::Compute(all, inSurface), &f, sp);
         Split(all, inSurface, 1, surface);
         if (holes)
             Split(all, inSurface, 0, *holes);
@@ -246,6 +260,10 @@ private:
             throw InputError("SODS dilation must be between 0 and 8 rings (1 is the paper's 26-neighbourhood).");
         if (!(p.sample_radius >= 0.25 && p.sample_radius <= 8))
             throw InputError("The sample radius must be between 0.25 and 8 sample spacings (1.25 is the default).");
+        if (p.boundary_smoothing < 0 || p.boundary_smoothing > 100)
+            throw InputError("Boundary smoothing must be between 0 and 100 iterations (4 is the paper's choice).");
+        if (!(p.boundary_trim >= 0 && p.boundary_trim <= 8))
+            throw InputError("The boundary trim must be between 0 (off) and 8 sample spacings.");
         if (p.min_boundary_edges < 0)
             throw InputError("The minimum number of boundary edges cannot be negative (0 keeps every hole).");
         if (p.normal_neighbours < 3 || p.normal_neighbours > 256)
