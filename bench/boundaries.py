@@ -23,6 +23,7 @@ CASES = ["bun_zipper.ply", "mech-holes-shark.off", "fandisk_truncated.off", "tum
 METHODS = {
     "ours (defaults)": {},
     "ours, trim 0.75": {"boundary_trim": 0.75},
+    "ours, trim 0.6": {"boundary_trim": 0.6},
     "ours, no trim, no smoothing": {"boundary_trim": 0.0, "boundary_smoothing": 0},
     "paper SODS (cells + 1 ring), smoothing 4": {"sods_occupancy": "Sample cells (paper)", "sods_dilation": 1,
                                                  "boundary_trim": 0.0},

@@ -2,15 +2,20 @@
 /// \file boundary_trim.h
 /// Peels off the rim of surface that the SODS lets past the last samples. Tangent disks (or
 /// the paper's dilation) extend the occupancy beyond a scan's boundary by their radius, and
-/// the implicit surface fills that margin; the faces there are farther from every sample than
-/// the sampling's own gaps. Starting at the boundary, faces whose centroid is farther from its
-/// nearest sample than that sample's `reach` are removed, then their neighbours in turn, so
-/// interior gaps (enclosed by supported faces) are never touched.
+/// the implicit surface fills that margin. Starting at the boundary, a face is removed when it
+/// is unsupported: its centroid is farther from its nearest sample than that sample's `reach`,
+/// and the samples around it all lie to one side (seen from the centroid in the face's plane,
+/// their directions leave a gap wider than kOutsideGap). Then its neighbours are examined in
+/// turn. The side test keeps the peel out of the gaps between samples inside the scan, which
+/// can be as wide as the reach on a regular grid (a square grid's gaps are 0.71 spacings).
 
 #include "mesh.h"
 #include "parallel.h"
 #include "samples.h"
 
+#include <Eigen/Geometry>
+
+#include <array>
 #include <deque>
 #include <unordered_map>
 #include <vector>
@@ -20,6 +25,9 @@ namespace ib {
 class BoundaryTrim
 {
 public:
+    static constexpr double kOutsideGap = 135 * M_PI / 180;
+    static constexpr int kAround = 8;  ///< samples examined around a face
+
     /// Among the faces f of `mesh` with inSurface[f], removes (sets inSurface[f] = 0) those
     /// reachable from the boundary through unsupported faces. reach: per sample, the largest
     /// supported distance. Returns the number of faces removed.
@@ -27,7 +35,7 @@ public:
                           std::vector<char>& inSurface, int threads = 0)
     {
         const size_t n = mesh.face.size();
-        std::vector<char> unsupported(n, 0);
+        std::vector<char> far(n, 0);
         ParallelFor(n, threads, [&](size_t begin, size_t end, int) {
             SampleIndex::Queue queue;
             for (size_t f = begin; f < end; ++f) {
@@ -35,31 +43,58 @@ public:
                     continue;
                 const vcg::Point3d c = vcg::Barycenter(mesh.face[f]);
                 samples.Nearest(Eigen::Vector3d(c[0], c[1], c[2]), 1, queue);
-                unsupported[f] = std::sqrt(queue.getWeight(0)) > reach[queue.getIndex(0)];
+                far[f] = std::sqrt(queue.getWeight(0)) > reach[queue.getIndex(0)];
             }
         });
+        SampleIndex::Queue queue;
+        auto unsupported = [&](size_t f) { return far[f] && SamplesOnOneSide(mesh.face[f], samples, queue); };
 
         const std::vector<std::array<int, 3>> across = Neighbours(mesh, inSurface);
-        std::deque<int> queue;
+        std::deque<int> pending;
         for (size_t f = 0; f < n; ++f)
-            if (inSurface[f] && unsupported[f] && std::count(across[f].begin(), across[f].end(), -1) > 0)
-                queue.push_back(int(f));
+            if (inSurface[f] && far[f] && std::count(across[f].begin(), across[f].end(), -1) > 0)
+                pending.push_back(int(f));
         size_t removed = 0;
-        while (!queue.empty()) {
-            const int f = queue.front();
-            queue.pop_front();
-            if (!inSurface[size_t(f)] || !unsupported[size_t(f)])
+        while (!pending.empty()) {
+            const size_t f = size_t(pending.front());
+            pending.pop_front();
+            if (!inSurface[f] || !unsupported(f))
                 continue;
-            inSurface[size_t(f)] = 0;
+            inSurface[f] = 0;
             ++removed;
-            for (int g : across[size_t(f)])
+            for (int g : across[f])
                 if (g >= 0)
-                    queue.push_back(g);
+                    pending.push_back(g);
         }
         return removed;
     }
 
 private:
+    /// True when the kAround samples nearest to the face's centroid, projected onto the face's
+    /// plane, leave an angular gap wider than kOutsideGap around it.
+    static bool SamplesOnOneSide(const CoreFace& face, const SampleIndex& samples, SampleIndex::Queue& queue)
+    {
+        const vcg::Point3d bc = vcg::Barycenter(face), nn = vcg::TriangleNormal(face);
+        const Eigen::Vector3d c(bc[0], bc[1], bc[2]);
+        Eigen::Vector3d n(nn[0], nn[1], nn[2]);
+        if (!(n.norm() > 0))
+            return true;
+        n.normalize();
+        const Eigen::Vector3d u = n.unitOrthogonal(), v = n.cross(u);
+        samples.Nearest(c, kAround, queue);
+        std::array<double, kAround> angle;
+        const int found = queue.getNofElements();
+        for (int i = 0; i < found; ++i) {
+            const Eigen::Vector3d d = samples.P().row(queue.getIndex(i)).transpose() - c;
+            angle[size_t(i)] = std::atan2(d.dot(v), d.dot(u));
+        }
+        std::sort(angle.begin(), angle.begin() + found);
+        double gap = found > 0 ? angle[0] + 2 * M_PI - angle[size_t(found - 1)] : 2 * M_PI;
+        for (int i = 1; i < found; ++i)
+            gap = std::max(gap, angle[size_t(i)] - angle[size_t(i - 1)]);
+        return gap > kOutsideGap;
+    }
+
     /// Per face in the surface: the surface face across each edge, or -1.
     static std::vector<std::array<int, 3>> Neighbours(const CoreMesh& mesh, const std::vector<char>& inSurface)
     {

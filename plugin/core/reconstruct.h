@@ -10,6 +10,7 @@
 #include "gated_mc.h"
 #include "implicit/hoppe.h"
 #include "normals.h"
+#include "pinches.h"
 #include "sods.h"
 #include "spacing.h"
 
@@ -75,7 +76,7 @@ public:
         int min_boundary_edges = kDefaultMinBoundaryEdges;
         /// Faces at the boundary farther than this many local spacings from every sample are
         /// peeled off (the margin the SODS adds past the scan's edge). 0 = no trim.
-        double boundary_trim = 0.6;
+        double boundary_trim = 0.5;
         int boundary_smoothing = 4;  ///< iterations of collinearity moves (paper §3.3), 0 = off
         int threads = 0;             ///< 0 = all cores
     };
@@ -86,6 +87,7 @@ public:
         std::vector<int> loops_before_filling;  ///< edge counts of all loops before small holes were filled
         int holes_filled = 0;             ///< hole regions added to the surface
         size_t faces_trimmed = 0;         ///< unsupported faces peeled off the boundary
+        size_t faces_unpinched = 0;       ///< faces of smaller fans removed at pinch vertices
         size_t hole_cells = 0;
         bool hole_search_capped = false;
         int resolution = 0;
@@ -179,6 +181,7 @@ public:
         r.holes_filled = int(std::count(fill.begin(), fill.end(), 1));
         if (p.boundary_trim > 0)
             r.faces_trimmed = BoundaryTrim::Compute(all, samples, p.boundary_trim * spacing, inSurface, p.threads);
+        r.faces_unpinched = Pinches::Resolve(all, inSurface);
         // Smoothed on the whole extraction, so the hole triangles follow the boundary.
         BoundarySmoothing::Param sp;
         sp.iterations = p.boundary_smoothing;

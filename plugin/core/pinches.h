@@ -1,0 +1,91 @@
+#pragma once
+/// \file pinches.h
+/// Pinch vertices: where two fans of surface faces meet at a single vertex (cells gated
+/// diagonally, a trim meeting itself), the surface is not a 2-manifold and the boundary touches
+/// itself. The smaller fans at such a vertex are moved out of the surface (into the holes, so
+/// surface + holes stays closed), until none is left.
+
+#include "mesh.h"
+
+#include <algorithm>
+#include <numeric>
+#include <vector>
+
+namespace ib {
+
+class Pinches
+{
+public:
+    /// Among the faces f of `mesh` with inSurface[f], removes (sets to 0) the smaller fans at
+    /// every pinch vertex, repeating while removals create new pinches (at most `passes`).
+    /// Returns the number of faces removed.
+    static size_t Resolve(const CoreMesh& mesh, std::vector<char>& inSurface, int passes = 8)
+    {
+        std::vector<std::vector<int>> around(mesh.vert.size());
+        for (size_t f = 0; f < mesh.face.size(); ++f)
+            for (int i = 0; i < 3; ++i)
+                around[vcg::tri::Index(mesh, mesh.face[f].cV(i))].push_back(int(f));
+
+        size_t removed = 0;
+        for (int pass = 0; pass < passes; ++pass) {
+            size_t now = 0;
+            for (size_t v = 0; v < around.size(); ++v)
+                now += RemoveSmallerFans(mesh, int(v), around[v], inSurface);
+            removed += now;
+            if (now == 0)
+                break;
+        }
+        return removed;
+    }
+
+private:
+    /// Groups the surface faces around vertex v into fans (faces sharing an edge through v);
+    /// keeps the largest fan, removes the others. Returns the faces removed.
+    static size_t RemoveSmallerFans(const CoreMesh& mesh, int v, const std::vector<int>& faces, std::vector<char>& inSurface)
+    {
+        std::vector<int> local;
+        for (int f : faces)
+            if (inSurface[size_t(f)])
+                local.push_back(f);
+        if (local.size() < 2)
+            return 0;
+        std::vector<int> parent(local.size());
+        std::iota(parent.begin(), parent.end(), 0);
+        auto find = [&](int i) {
+            while (parent[size_t(i)] != i)
+                i = parent[size_t(i)] = parent[size_t(parent[size_t(i)])];
+            return i;
+        };
+        // Two faces around v are in one fan when they share an edge v-w.
+        for (size_t a = 0; a < local.size(); ++a)
+            for (size_t b = a + 1; b < local.size(); ++b)
+                if (SharedEdgeThrough(mesh, v, local[a], local[b]))
+                    parent[size_t(find(int(a)))] = find(int(b));
+        std::vector<int> size(local.size(), 0);
+        for (size_t i = 0; i < local.size(); ++i)
+            ++size[size_t(find(int(i)))];
+        const int keep = int(std::max_element(size.begin(), size.end()) - size.begin());
+        size_t removed = 0;
+        for (size_t i = 0; i < local.size(); ++i)
+            if (find(int(i)) != keep) {
+                inSurface[size_t(local[i])] = 0;
+                ++removed;
+            }
+        return removed;
+    }
+
+    static bool SharedEdgeThrough(const CoreMesh& mesh, int v, int fa, int fb)
+    {
+        for (int i = 0; i < 3; ++i) {
+            const int w = int(vcg::tri::Index(mesh, mesh.face[size_t(fa)].cV(i)));
+            if (w == v)
+                continue;
+            for (int j = 0; j < 3; ++j)
+                if (int(vcg::tri::Index(mesh, mesh.face[size_t(fb)].cV(j))) == w)
+                    return true;
+        }
+        return false;
+    }
+};
+
+} // namespace ib

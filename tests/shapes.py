@@ -1,0 +1,45 @@
+"""Generated point clouds with known boundaries, and checks on reconstructed meshes."""
+import numpy as np
+import pymeshlab
+
+
+def fibonacci_sphere(n):
+    """n nearly uniform unit vectors (points on the unit sphere, also their outward normals)."""
+    i = np.arange(n) + 0.5
+    z = 1 - 2 * i / n
+    phi = np.pi * (3 - np.sqrt(5)) * i
+    r = np.sqrt(1 - z * z)
+    return np.column_stack([r * np.cos(phi), r * np.sin(phi), z])
+
+
+def cylinder(radius=1.0, height=2.0, spacing=0.04):
+    """Open cylinder around z, z in [-height/2, height/2]: points, outward normals."""
+    n_around = int(round(2 * np.pi * radius / spacing))
+    n_up = int(round(height / spacing)) + 1
+    theta, z = np.meshgrid(np.arange(n_around) * 2 * np.pi / n_around, np.linspace(-height / 2, height / 2, n_up))
+    theta = theta + (np.arange(n_up)[:, None] % 2) * np.pi / n_around  # staggered rows
+    normals = np.column_stack([np.cos(theta).ravel(), np.sin(theta).ravel(), np.zeros(theta.size)])
+    return np.column_stack([radius * normals[:, :2], z.ravel()]), normals
+
+
+def torus(R=1.0, r=0.4, spacing=0.035):
+    """Torus around z: points, outward normals."""
+    n_major = int(round(2 * np.pi * (R + r) / spacing))
+    n_minor = int(round(2 * np.pi * r / spacing))
+    u, v = np.meshgrid(np.arange(n_major) * 2 * np.pi / n_major, np.arange(n_minor) * 2 * np.pi / n_minor)
+    u, v = u.ravel(), v.ravel()
+    normals = np.column_stack([np.cos(v) * np.cos(u), np.cos(v) * np.sin(u), np.sin(v)])
+    centre = np.column_stack([R * np.cos(u), R * np.sin(u), np.zeros_like(u)])
+    return centre + r * normals, normals
+
+
+def check_oriented_manifold(vertices, faces):
+    """Asserts that the mesh is a 2-manifold with boundary, consistently oriented, finite."""
+    assert np.all(np.isfinite(vertices))
+    directed = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
+    assert len(np.unique(directed, axis=0)) == len(directed), "a directed edge twice: orientation flips"
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=vertices, face_matrix=faces))
+    topology = ms.get_topological_measures()
+    assert topology["non_two_manifold_edges"] == 0
+    assert topology["non_two_manifold_vertices"] == 0
