@@ -22,9 +22,10 @@ DEFAULT_DATA = Path(__file__).resolve().parent.parent.parent / "shared" / "data"
 CASES = ["bun_zipper.ply", "mech-holes-shark.off", "fandisk_truncated.off", "tum_rabbit.ply", "gargoyle.ply"]
 METHODS = {
     "ours (defaults)": {},
-    "ours, trim 0.75": {"boundary_trim": 0.75},
-    "ours, trim 0.6": {"boundary_trim": 0.6},
+    "ours, no smoothing": {"boundary_smoothing": 0},
+    "ours, no trim": {"boundary_trim": 0.0},
     "ours, no trim, no smoothing": {"boundary_trim": 0.0, "boundary_smoothing": 0},
+    "ours, min_boundary_edges 0": {"min_boundary_edges": 0},
     "paper SODS (cells + 1 ring), smoothing 4": {"sods_occupancy": "Sample cells (paper)", "sods_dilation": 1,
                                                  "boundary_trim": 0.0},
 }

@@ -257,9 +257,9 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 		r.lattice_cells[0], r.lattice_cells[1], r.lattice_cells[2], r.cell_size, r.resolution,
 		r.resolution_automatic ? ", automatic" : "", r.sample_spacing);
 	log("Surface: %d faces, %d vertices; %d boundary loops kept (edges: %s); %d small holes "
-		"filled (loops under %d edges).",
+		"filled (loops under %d edges); %zu unsupported faces trimmed off the boundary.",
 		out->cm.fn, out->cm.vn, int(r.loops.size()), qUtf8Printable(loopSummary(r.loops)),
-		r.holes_filled, p.min_boundary_edges);
+		r.holes_filled, p.min_boundary_edges, r.faces_trimmed);
 	log("%zu SODS cells, %zu hole cells%s; %zu implicit evaluations instead of %.0f for the full "
 		"lattice.",
 		r.sods_cells, r.hole_cells, r.hole_search_capped ? " (search capped: larger holes kept open)" : "",
@@ -274,6 +274,7 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 		std::vector<double>(r.loops_before_filling.begin(), r.loops_before_filling.end())));
 	res["holes_filled"] = r.holes_filled;
 	res["hole_cells"] = double(r.hole_cells);
+	res["faces_trimmed"] = double(r.faces_trimmed);
 	res["surface_faces"] = out->cm.fn;
 	res["surface_vertices"] = out->cm.vn;
 	res["resolution"] = r.resolution;

@@ -69,6 +69,33 @@ public:
         return removed;
     }
 
+    /// Removes (sets inSurface to 0) the connected pieces of surface with fewer than
+    /// `min_faces` faces: the scraps a trim leaves beside a boundary. Returns faces removed.
+    static size_t RemoveScraps(const CoreMesh& mesh, std::vector<char>& inSurface, size_t min_faces)
+    {
+        const std::vector<std::array<int, 3>> across = Neighbours(mesh, inSurface);
+        std::vector<int> piece(mesh.face.size(), -1);
+        size_t removed = 0;
+        for (size_t seed = 0; seed < mesh.face.size(); ++seed) {
+            if (!inSurface[seed] || piece[seed] >= 0)
+                continue;
+            std::vector<int> members{int(seed)};
+            piece[seed] = int(seed);
+            for (size_t i = 0; i < members.size(); ++i)
+                for (int g : across[size_t(members[i])])
+                    if (g >= 0 && piece[size_t(g)] < 0) {
+                        piece[size_t(g)] = int(seed);
+                        members.push_back(g);
+                    }
+            if (members.size() < min_faces) {
+                for (int f : members)
+                    inSurface[size_t(f)] = 0;
+                removed += members.size();
+            }
+        }
+        return removed;
+    }
+
 private:
     /// True when the kAround samples nearest to the face's centroid, projected onto the face's
     /// plane, leave an angular gap wider than kOutsideGap around it.

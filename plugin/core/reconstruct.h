@@ -182,6 +182,8 @@ public:
         if (p.boundary_trim > 0)
             r.faces_trimmed = BoundaryTrim::Compute(all, samples, p.boundary_trim * spacing, inSurface, p.threads);
         r.faces_unpinched = Pinches::Resolve(all, inSurface);
+        if (p.boundary_trim > 0)  // a piece smaller than the smallest hole kept is a scrap of the trim
+            r.faces_trimmed += BoundaryTrim::RemoveScraps(all, inSurface, size_t(p.min_boundary_edges * p.min_boundary_edges / 4));
         // Smoothed on the whole extraction, so the hole triangles follow the boundary.
         BoundarySmoothing::Param sp;
         sp.iterations = p.boundary_smoothing;
