@@ -1,0 +1,101 @@
+// Trim, pinch resolution, scraps and smoothing, on hand-made meshes and a flat scan.
+#include "boundary_trim.h"
+#include "geometry.h"
+#include "pinches.h"
+#include "reconstruct.h"
+
+#include <gtest/gtest.h>
+
+using namespace ib;
+
+namespace {
+void AddTriangle(CoreMesh& m, const vcg::Point3d& a, const vcg::Point3d& b, const vcg::Point3d& c)
+{
+    vcg::tri::Allocator<CoreMesh>::AddFace(m, a, b, c);
+}
+
+/// A flat square scan: samples on a staggered grid of spacing s over [0, 1]^2 at z = 0.
+void FlatScan(double s, Points& P, Points& N)
+{
+    std::vector<Eigen::Vector3d> pts;
+    const int n = int(std::round(1 / s));
+    for (int j = 0; j <= n; ++j)
+        for (int i = 0; i <= n; ++i)
+            pts.emplace_back(std::min(1.0, (i + 0.5 * (j % 2)) * s), j * s, 0.0);
+    P.resize(Eigen::Index(pts.size()), 3);
+    N.resize(Eigen::Index(pts.size()), 3);
+    for (size_t i = 0; i < pts.size(); ++i) {
+        P.row(Eigen::Index(i)) = pts[i].transpose();
+        N.row(Eigen::Index(i)) << 0, 0, 1;
+    }
+}
+
+/// Largest distance from a loop vertex to the square's border, and the loop's length.
+std::pair<double, double> RimError(const CoreMesh& m, const BoundaryLoop& loop)
+{
+    double worst = 0;
+    for (int v : loop.vertices) {
+        const auto& q = m.vert[size_t(v)].cP();
+        const double inside = std::min({q[0], 1 - q[0], q[1], 1 - q[1]});  // negative outside
+        worst = std::max({worst, std::abs(inside), std::abs(q[2])});
+    }
+    return {worst, loop.length};
+}
+} // namespace
+
+TEST(BoundarySteps, FlatScanIsTrimmedToItsBorderAndSmoothed)
+{
+    Points P, N;
+    FlatScan(0.02, P, N);
+    Reconstruction::Param raw;
+    raw.boundary_trim = 0;
+    raw.boundary_smoothing = 0;
+    CoreMesh m0, m1;
+    const auto r0 = Reconstruction::Compute(P, N, raw, m0);
+    const auto r1 = Reconstruction::Compute(P, N, Reconstruction::Param(), m1);
+    ASSERT_EQ(r0.loops.size(), 1u);
+    ASSERT_EQ(r1.loops.size(), 1u);
+    const auto [error0, length0] = RimError(m0, r0.loops[0]);
+    const auto [error1, length1] = RimError(m1, r1.loops[0]);
+    // Untrimmed, the SODS margin (a tangent disk, 1.25 spacings) shows; trimmed, the boundary
+    // is within 1.5 cells of the square's border and, smoothed, about as long as it (4).
+    EXPECT_GT(error0, 1.5 * r0.cell_size);
+    EXPECT_LT(error1, 1.5 * r1.cell_size);
+    EXPECT_GT(r1.faces_trimmed, 0u);
+    EXPECT_NEAR(length1, 4.0, 0.4);
+    EXPECT_GT(length0, length1);
+    const auto t = test::Check(m1);
+    EXPECT_EQ(t.non_manifold_edges, 0);
+    EXPECT_EQ(t.non_manifold_vertices, 0);
+    EXPECT_TRUE(t.oriented);
+}
+
+TEST(BoundarySteps, PinchKeepsTheLargerFan)
+{
+    // Three triangles around the origin on one side, one on the other: they meet only at (0,0,0).
+    CoreMesh m;
+    const vcg::Point3d o(0, 0, 0);
+    AddTriangle(m, o, vcg::Point3d(1, 0, 0), vcg::Point3d(1, 1, 0));
+    AddTriangle(m, o, vcg::Point3d(1, 1, 0), vcg::Point3d(0, 1, 0));
+    AddTriangle(m, o, vcg::Point3d(0, 1, 0), vcg::Point3d(-0.2, 1, 0));
+    AddTriangle(m, o, vcg::Point3d(-1, -1, 0), vcg::Point3d(0, -1, 0));
+    vcg::tri::Clean<CoreMesh>::RemoveDuplicateVertex(m);
+    std::vector<char> inSurface(4, 1);
+    EXPECT_EQ(Pinches::Resolve(m, inSurface), 1u);
+    EXPECT_EQ(inSurface, (std::vector<char>{1, 1, 1, 0}));
+}
+
+TEST(BoundarySteps, ScrapsBelowTheSizeAreRemoved)
+{
+    CoreMesh m;
+    for (int i = 0; i < 6; ++i)  // a fan of 6 connected triangles
+        AddTriangle(m, vcg::Point3d(0, 0, 0), vcg::Point3d(std::cos(i), std::sin(i), 0),
+                    vcg::Point3d(std::cos(i + 1), std::sin(i + 1), 0));
+    AddTriangle(m, vcg::Point3d(5, 0, 0), vcg::Point3d(6, 0, 0), vcg::Point3d(5, 1, 0));  // alone
+    vcg::tri::Clean<CoreMesh>::RemoveDuplicateVertex(m);
+    vcg::tri::Allocator<CoreMesh>::CompactEveryVector(m);
+    std::vector<char> inSurface(7, 1);
+    EXPECT_EQ(BoundaryTrim::RemoveScraps(m, inSurface, 2), 1u);
+    EXPECT_EQ(inSurface.back(), 0);
+    EXPECT_EQ(std::count(inSurface.begin(), inSurface.end(), 1), 6);
+}
