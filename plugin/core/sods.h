@@ -83,9 +83,6 @@ public:
     /// Number of occupied cells.
     size_t Count() const { return count_; }
 
-    /// Bytes held by the bricks (payload only).
-    size_t Bytes() const { return bricks_.size() * sizeof(Brick); }
-
     /// The occupancy grown by one ring of 26-neighbours, clipped to the lattice.
     Sods Dilated() const
     {
