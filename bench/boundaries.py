@@ -1,11 +1,13 @@
 """Boundary benchmark on the meshes with known boundaries (DESIGN.md section 5, first part).
 
 For each mesh: its vertices and face normals as the input point cloud, reconstructed with our
-defaults (tangent-disk SODS, automatic resolution) and with the paper's SODS (sample cells +
-one 26-ring); reports loops found against the true boundaries, the implicit evaluations
-against a full lattice, and the time against MeshLab's screened Poisson in the same run.
+defaults (tangent-disk SODS, automatic resolution) and variants; reports loops found against
+the true boundaries, the boundary distance, the implicit evaluations against a full lattice,
+and the time against MeshLab's screened Poisson in the same run. With --references, also
+clean and noisy input (0.2%-diagonal Gaussian noise on the points) against MeshLab's screened
+Poisson, Poisson with the 5% least dense vertices removed, and ball pivoting.
 
-    python bench/boundaries.py [--data DIR] > results.md
+    python bench/boundaries.py [--data DIR] [--references] > results.md
 """
 import argparse
 import time
@@ -75,11 +77,55 @@ def poisson_seconds(points, normals, resolution):
     return time.perf_counter() - t
 
 
+def reference_loops(name, points, normals, resolution):
+    """Boundary loops (point arrays) and seconds of a MeshLab reference method."""
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=points, v_normals_matrix=normals), "points")
+    t = time.perf_counter()
+    if name == "ball pivoting":
+        ms.generate_surface_reconstruction_ball_pivoting()
+    else:
+        ms.generate_surface_reconstruction_screened_poisson(depth=int(round(np.log2(resolution))))
+    seconds = time.perf_counter() - t
+    m = ms.current_mesh()
+    vertices, faces = m.vertex_matrix(), m.face_matrix()
+    if name == "screened Poisson + 5% density trim":
+        density = m.vertex_scalar_array()  # Poisson stores its sample density as vertex quality
+        faces = faces[np.all(density[faces] >= np.quantile(density, 0.05), axis=1)]
+    return [vertices[h] for h in boundary_vertex_sets(faces, len(vertices))], seconds
+
+
+def references(args):
+    print("| mesh | input | method | loops (true) | true found | spurious (≥10 edges / all) | boundary distance (% diag) |")
+    print("|---|---|---|---|---|---|---|")
+    rng = np.random.default_rng(1)
+    for name in CASES:
+        clean, normals, faces = load_case(args.data / name)
+        truth = [clean[h] for h in boundary_vertex_sets(faces, len(clean))]
+        diagonal = np.linalg.norm(clean.max(0) - clean.min(0))
+        for label, points in [("clean", clean), ("noise 0.2%", clean + rng.normal(0, 0.002 * diagonal, clean.shape))]:
+            ours, _, found, spurious, distance = run(points, normals, truth, 0, {})
+            rows = [("ours", ours["boundary_loops"], found, spurious, distance)]
+            for method in ["screened Poisson", "screened Poisson + 5% density trim", "ball pivoting"]:
+                loops, _ = reference_loops(method, points, normals, ours["resolution"])
+                tolerance = 2.5 * ours["sample_spacing"] + 2 * ours["cell_size"]
+                matched = match_loops(truth, loops, tolerance)
+                assigned = {i for ids in matched.values() for i in ids}
+                rows.append((method, len(loops), sum(max(len(loops[i]) for i in ids) >= 10 for ids in matched.values()),
+                             [len(l) for i, l in enumerate(loops) if i not in assigned], boundary_distance(truth, loops)))
+            for method, count, found, spurious, distance in rows:
+                print(f"| {name} | {label} | {method} | {count} ({len(truth)}) | {found}/{len(truth)} "
+                      f"| {sum(s >= 10 for s in spurious)} / {len(spurious)} | {100 * distance / diagonal:.3f} |")
+
+
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--data", type=Path, default=DEFAULT_DATA)
+    p.add_argument("--references", action="store_true", help="clean and noisy input against MeshLab's methods")
     args = p.parse_args(argv)
     implicit_boundaries.load()
+    if args.references:
+        return references(args)
     print("| mesh | samples | true loops | method | resolution | loops | true found | spurious (≥10 edges / all) "
           "| largest loops | boundary distance (% diag) | evaluations / full lattice | time / screened Poisson |")
     print("|---|---|---|---|---|---|---|---|---|---|---|---|")

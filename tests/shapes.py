@@ -43,3 +43,12 @@ def check_oriented_manifold(vertices, faces):
     topology = ms.get_topological_measures()
     assert topology["non_two_manifold_edges"] == 0
     assert topology["non_two_manifold_vertices"] == 0
+
+
+def moebius(half_width=0.3, spacing=0.02):
+    """Möbius strip around a unit circle (one half twist): points and the parameters (u, w)
+    of each, w being the signed distance across the strip (its boundary is |w| = half_width)."""
+    u, w = np.meshgrid(np.arange(0, 2 * np.pi, spacing), np.arange(-half_width, half_width + 1e-9, spacing))
+    u, w = u.ravel(), w.ravel()
+    points = np.column_stack([(1 + w * np.cos(u / 2)) * np.cos(u), (1 + w * np.cos(u / 2)) * np.sin(u), w * np.sin(u / 2)])
+    return points, u, w

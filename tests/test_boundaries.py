@@ -3,7 +3,9 @@ import numpy as np
 import pytest
 
 import implicit_boundaries
-from shapes import check_oriented_manifold, cylinder, fibonacci_sphere, torus
+from scipy.spatial import cKDTree
+
+from shapes import check_oriented_manifold, cylinder, fibonacci_sphere, moebius, torus
 
 
 def test_open_cylinder_has_two_loops_at_its_rims():
@@ -84,3 +86,22 @@ def test_smoothing_shortens_the_boundary_and_keeps_it_on_the_rim(punched_sphere)
     # On the implicit surface (the unit sphere here): smoothing does not pull vertices inside.
     v = smooth.vertices[np.concatenate(smooth.loops)]
     assert np.abs(np.linalg.norm(v, axis=1) - 1).max() < 0.2 * smooth.info["cell_size"]
+
+
+def test_moebius_strip_has_one_loop_and_one_seam():
+    """A signed implicit function cannot represent a one-sided surface: the estimated normals
+    must flip somewhere, and the surface is cut there across the strip. What remains is one
+    oriented 2-manifold with a single boundary loop: the strip's boundary plus the two sides of
+    that one cut, which lies at a single place along the strip."""
+    points, u, w = moebius()
+    rec = implicit_boundaries.reconstruct(points, None)
+    assert len(rec.loops) == 1
+    cell = rec.info["cell_size"]
+    d, nearest = cKDTree(points[np.abs(w) > 0.29]).query(rec.vertices[rec.loops[0]])
+    seam = d > 3 * cell
+    assert seam.sum() < 0.15 * len(d)
+    _, on_strip = cKDTree(points).query(rec.vertices[rec.loops[0]][seam])
+    angles = u[on_strip]
+    spread = np.angle(np.exp(1j * (angles - angles[0])))  # around the circle
+    assert np.ptp(spread) < 0.2  # one cut, not several
+    check_oriented_manifold(rec.vertices, rec.faces)
