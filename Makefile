@@ -32,6 +32,9 @@ test-python: plugin
 gui: plugin
 	.ci/install-deps gui
 	tests/gui/check_plugin_loads.sh "$$(.ci/meshlab-gui)" python/implicit_boundaries/lib/libfilter_implicit_boundaries.so
+	@echo "Start MeshLab with the plugin: $$(.ci/meshlab-gui)/meshlab"
+	@echo "then Filters > Remeshing, Simplification and Reconstruction > Implicit reconstruction with boundaries"
+
 
 test: test-core test-python gui
 
