@@ -249,6 +249,8 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 		loopVertices.insert(loopVertices.end(), loop.vertices.begin(), loop.vertices.end());
 	}
 
+	if (r.duplicates_removed > 0)
+		log("Ignored %zu vertices at the same position as another one.", r.duplicates_removed);
 	if (r.normals_estimated)
 		log("Input had no usable normals (or estimation was requested): estimated them from %d "
 			"neighbours and oriented them by propagation%s.",
@@ -275,6 +277,7 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 	res["holes_filled"] = r.holes_filled;
 	res["hole_cells"] = double(r.hole_cells);
 	res["faces_trimmed"] = double(r.faces_trimmed);
+	res["duplicates_removed"] = double(r.duplicates_removed);
 	res["surface_faces"] = out->cm.fn;
 	res["surface_vertices"] = out->cm.vn;
 	res["resolution"] = r.resolution;

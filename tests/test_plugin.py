@@ -163,6 +163,8 @@ def test_empty_layer_raises_a_clear_error(plugin, tmp_path):
     (lambda: pymeshlab.Mesh(vertex_matrix=np.where(np.arange(60).reshape(20, 3) == 7, np.nan,
                                                    np.random.default_rng(1).random((20, 3)))), "NaN"),
     (lambda: pymeshlab.Mesh(vertex_matrix=np.ones((50, 3))), "same position"),
+    (lambda: pymeshlab.Mesh(vertex_matrix=np.outer(np.linspace(0, 1, 50), [1, 2, 3])), "one line"),
+    (lambda: pymeshlab.Mesh(vertex_matrix=np.repeat(np.eye(3), 10, axis=0)), "Only 3 distinct"),
 ])
 def test_bad_layers_raise_clear_errors(plugin, make, message):
     ms = pymeshlab.MeshSet()

@@ -51,3 +51,11 @@ def test_normals_must_match_points():
     points, normals = fibonacci_sphere(100)
     with pytest.raises(ValueError, match="one normal per point"):
         implicit_boundaries.reconstruct(points, normals[:50])
+
+
+def test_repeated_samples_are_ignored():
+    points, normals = fibonacci_sphere(3000)
+    rec = implicit_boundaries.reconstruct(np.repeat(points, 5, axis=0), np.repeat(normals, 5, axis=0))
+    assert rec.info["duplicates_removed"] == 4 * 3000
+    assert rec.loops == []
+    assert np.abs(np.linalg.norm(rec.vertices, axis=1) - 1).max() < 0.25 * rec.info["cell_size"]

@@ -17,7 +17,10 @@
 #include <vcg/complex/append.h>
 #include <vcg/complex/algorithms/update/selection.h>
 
+#include <Eigen/Eigenvalues>
+
 #include <chrono>
+#include <numeric>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -88,6 +91,7 @@ public:
         int holes_filled = 0;             ///< hole regions added to the surface
         size_t faces_trimmed = 0;         ///< unsupported faces peeled off the boundary
         size_t faces_unpinched = 0;       ///< faces of smaller fans removed at pinch vertices
+        size_t duplicates_removed = 0;    ///< samples at the same position as an earlier one
         size_t hole_cells = 0;
         bool hole_search_capped = false;
         int resolution = 0;
@@ -108,13 +112,22 @@ public:
     /// `surface` receives the extracted surface (vertices welded, faces along the normals);
     /// `holes`, when given, the hole triangles left open (surface + holes is closed where the
     /// implicit surface is). Loop vertex indices refer to `surface`.
-    static Result Compute(const Points& P, const Points& N, const Param& p, CoreMesh& surface,
+    static Result Compute(const Points& input, const Points& inputNormals, const Param& p, CoreMesh& surface,
                           CoreMesh* holes = nullptr, vcg::CallBackPos* cb = nullptr)
     {
         using Clock = std::chrono::steady_clock;
         auto seconds = [](Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); };
-        CheckInput(P, N, p);
+        CheckInput(input, inputNormals, p);
         Result r;
+        // Repeated samples (merged scans, exported meshes with seams) would make every
+        // neighbourhood collapse to one point and the spacing zero: keep one of each.
+        const std::vector<Eigen::Index> kept = DistinctRows(input);
+        r.duplicates_removed = size_t(input.rows() - Eigen::Index(kept.size()));
+        const Points P = input(kept, Eigen::all);
+        const Points N = inputNormals.rows() ? Points(inputNormals(kept, Eigen::all)) : Points();
+        if (P.rows() < kMinPoints)
+            throw InputError("Only " + std::to_string(P.rows()) + " distinct vertex positions; at least " +
+                             std::to_string(kMinPoints) + " are needed to fit tangent planes.");
 
         auto t = Clock::now();
         Points normals;
@@ -231,6 +244,29 @@ public:
         vcg::tri::Append<CoreMesh, CoreMesh>::MeshCopy(out, all, true);
     }
 
+    /// Indices of the rows of P, in order, skipping rows equal to an earlier one.
+    static std::vector<Eigen::Index> DistinctRows(const Points& P)
+    {
+        std::vector<Eigen::Index> order(size_t(P.rows()));
+        std::iota(order.begin(), order.end(), Eigen::Index(0));
+        auto less = [&](Eigen::Index a, Eigen::Index b) {
+            for (int c = 0; c < 3; ++c)
+                if (P(a, c) != P(b, c))
+                    return P(a, c) < P(b, c);
+            return a < b;
+        };
+        std::sort(order.begin(), order.end(), less);
+        std::vector<char> keep(size_t(P.rows()), 1);
+        for (size_t i = 1; i < order.size(); ++i)
+            if (P.row(order[i]) == P.row(order[i - 1]))
+                keep[size_t(order[i])] = 0;
+        std::vector<Eigen::Index> kept;
+        for (Eigen::Index i = 0; i < P.rows(); ++i)
+            if (keep[size_t(i)])
+                kept.push_back(i);
+        return kept;
+    }
+
     /// True when N holds a usable normal for every sample; false when it holds none at all
     /// (no rows, or all zero: what a point cloud without normals gets in MeshLab).
     static bool HasNormals(const Points& N)
@@ -257,6 +293,12 @@ private:
         const Eigen::Vector3d extent = (P.colwise().maxCoeff() - P.colwise().minCoeff()).transpose();
         if (!(extent.maxCoeff() > 0))
             throw InputError("All vertices are at the same position: there is no surface to reconstruct.");
+        // Second principal extent: zero when every sample lies on one line (a flat scan is fine).
+        const Points centred = P.rowwise() - P.colwise().mean();
+        const Eigen::Vector3d spread =
+            Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(centred.transpose() * centred).eigenvalues();  // ascending
+        if (!(spread[1] > 1e-12 * spread[2]))  // second extent under a millionth of the first
+            throw InputError("All vertices lie on one line: a surface needs samples spread in two directions.");
         if (p.resolution != 0 && (p.resolution < kMinResolution || p.resolution > kMaxResolution))
             throw InputError("Resolution " + std::to_string(p.resolution) + " is out of range: use 0 (automatic, " +
                              "from the sample spacing) or a value between " + std::to_string(kMinResolution) +
