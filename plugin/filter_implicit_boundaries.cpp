@@ -258,6 +258,10 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 	log("Lattice %dx%dx%d, cell %g (resolution %d%s, sample spacing %g).",
 		r.lattice_cells[0], r.lattice_cells[1], r.lattice_cells[2], r.cell_size, r.resolution,
 		r.resolution_automatic ? ", automatic" : "", r.sample_spacing);
+	if (r.resolution_automatic && r.resolution == ib::Reconstruction::kMaxAutoResolution)
+		log("Warning: the automatic resolution was capped at %d; the samples are far apart relative "
+			"to their spacing (separate clusters?). Set the resolution by hand if the result is too coarse.",
+			r.resolution);
 	log("Surface: %d faces, %d vertices; %d boundary loops kept (edges: %s); %d small holes "
 		"filled (loops under %d edges); %zu unsupported faces trimmed off the boundary.",
 		out->cm.fn, out->cm.vn, int(r.loops.size()), qUtf8Printable(loopSummary(r.loops)),

@@ -39,3 +39,13 @@ def test_bad_parameter_is_reported_not_raised(tmp_path, capsys, plugin):
 def test_info_reports_the_plugin(capsys, plugin):
     assert main(["info"]) == 0
     assert "loads" in capsys.readouterr().out
+
+
+def test_options_reach_the_filter(tmp_path, capsys, plugin):
+    keep_all = tmp_path / "all.ply"
+    assert main(["demo", "-o", str(keep_all), "--min-boundary-edges", "0", "--boundary-smoothing", "0"]) == 0
+    unfilled = capsys.readouterr().out
+    assert main(["demo", "-o", str(tmp_path / "default.ply")]) == 0
+    filled = capsys.readouterr().out
+    count = lambda text: int(text.split(" boundary loops kept")[0].split()[-1])
+    assert count(unfilled) > count(filled)

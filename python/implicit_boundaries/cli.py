@@ -30,7 +30,8 @@ def _point_cloud(ms: pymeshlab.MeshSet, path: Path) -> None:
 
 def _reconstruct(ms: pymeshlab.MeshSet, args) -> dict:
     load()
-    params = {name: getattr(args, name) for name in ("resolution", "sods_dilation", "sample_radius")
+    params = {name: getattr(args, name)
+              for name in ("resolution", "sods_dilation", "sample_radius", "min_boundary_edges", "boundary_smoothing")
               if getattr(args, name) is not None}
     if args.paper_occupancy:
         params["sods_occupancy"] = "Sample cells (paper)"
@@ -87,6 +88,9 @@ def _parser() -> argparse.ArgumentParser:
         q.add_argument("--resolution", type=int, help="cells along the longest side (default 0: from the sample spacing)")
         q.add_argument("--sample-radius", type=float, help="tangent disk radius in sample spacings (default 1.25)")
         q.add_argument("--sods-dilation", type=int, help="rings of neighbour cells added to the SODS (default 0)")
+        q.add_argument("--min-boundary-edges", type=int,
+                       help="fill holes whose loops have fewer edges (default 12; 0 keeps every hole)")
+        q.add_argument("--boundary-smoothing", type=int, help="smoothing passes along each loop (default 4; 0 = off)")
         q.add_argument("--paper-occupancy", action="store_true",
                        help="SODS from the cells holding samples, as in the paper (use with --sods-dilation 1)")
         q.add_argument("--estimate-normals", action="store_true", help="ignore the input's normals")
