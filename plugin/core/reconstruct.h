@@ -130,17 +130,7 @@ public:
                              std::to_string(kMinPoints) + " are needed to fit tangent planes.");
 
         auto t = Clock::now();
-        Points normals;
-        if (p.normals == NormalSource::Estimate || !HasNormals(N)) {
-            if (cb) cb(2, "Estimating normals");
-            PointNormals::Param np;
-            np.neighbours = p.normal_neighbours;
-            np.viewpoint = p.viewpoint;
-            normals = PointNormals::Compute(P, np, &r.normals_flipped);
-            r.normals_estimated = true;
-        } else {
-            normals = N.rowwise().normalized();
-        }
+        const Points normals = OrientedNormals(P, N, p, r, cb);
         r.seconds_normals = seconds(t);
 
         t = Clock::now();
@@ -159,8 +149,12 @@ public:
         if (r.resolution_automatic)
             r.resolution = std::clamp(int(std::lround(longest / (kCellPerSpacing * r.sample_spacing))),
                                       kMinResolution, kMaxAutoResolution);
-        // Padding keeps every SODS cell and its corners inside the lattice.
-        const int diskCells = p.occupancy == Occupancy::TangentDisks ? 1 : 0;
+        // Padding keeps every SODS cell and its corners inside the lattice: the widest disk
+        // (capped at the lattice size: an outlier's disk may be clipped), the dilation, one more.
+        const double cell = longest / r.resolution;
+        const int diskCells = p.occupancy == Occupancy::TangentDisks
+                                  ? std::min(r.resolution, int(std::ceil(p.sample_radius * spacing.maxCoeff() / cell)))
+                                  : 0;
         const Lattice lattice = Lattice::Fit(lo, hi, r.resolution, p.sods_dilation + diskCells + 1);
         r.cell_size = lattice.cell_size;
         r.lattice_cells = lattice.cells;
@@ -185,6 +179,35 @@ public:
 
         t = Clock::now();
         if (cb) cb(97, "Tracing boundary loops, filling small holes");
+        const std::vector<char> inSurface = Boundaries(all, mc, samples, spacing, f, lattice.cell_size, p, r);
+        Split(all, inSurface, 1, surface);
+        if (holes)
+            Split(all, inSurface, 0, *holes);
+        r.loops = BoundaryLoops::Compute(surface);
+        r.seconds_boundaries = seconds(t);
+        return r;
+    }
+
+    /// Unit normals: the layer's, or estimated ones (and says so in r).
+    static Points OrientedNormals(const Points& P, const Points& N, const Param& p, Result& r, vcg::CallBackPos* cb)
+    {
+        if (p.normals == NormalSource::LayerOrEstimate && HasNormals(N))
+            return N.rowwise().normalized();
+        if (cb) cb(2, "Estimating normals");
+        PointNormals::Param np;
+        np.neighbours = p.normal_neighbours;
+        np.viewpoint = p.viewpoint;
+        r.normals_estimated = true;
+        return PointNormals::Compute(P, np, &r.normals_flipped);
+    }
+
+    /// The boundary stage on the whole extraction `all` (surface faces first, then hole faces):
+    /// fills small holes, trims, removes pinches and scraps, smooths. Returns which faces are
+    /// surface. Smoothing works on surface and hole faces alike, so the holes follow the boundary.
+    static std::vector<char> Boundaries(CoreMesh& all, const GatedMarchingCubes::Result& mc, const SampleIndex& samples,
+                                        const Eigen::VectorXd& spacing, const ImplicitFunction& f, double cell,
+                                        const Param& p, Result& r)
+    {
         std::vector<char> inSurface(all.face.size(), 0);
         std::fill(inSurface.begin(), inSurface.begin() + long(mc.surface_faces), 1);
         const std::vector<int> fill = SmallHoles(all, inSurface, mc, p.min_boundary_edges, r.loops_before_filling);
@@ -197,17 +220,11 @@ public:
         r.faces_unpinched = Pinches::Resolve(all, inSurface);
         if (p.boundary_trim > 0)  // a piece smaller than the smallest hole kept is a scrap of the trim
             r.faces_trimmed += BoundaryTrim::RemoveScraps(all, inSurface, size_t(p.min_boundary_edges * p.min_boundary_edges / 4));
-        // Smoothed on the whole extraction, so the hole triangles follow the boundary.
         BoundarySmoothing::Param sp;
         sp.iterations = p.boundary_smoothing;
-        sp.cell_size = lattice.cell_size;
+        sp.cell_size = cell;
         BoundarySmoothing::Compute(all, BoundaryLoops::Compute(all, inSurface), &f, sp);
-        Split(all, inSurface, 1, surface);
-        if (holes)
-            Split(all, inSurface, 0, *holes);
-        r.loops = BoundaryLoops::Compute(surface);
-        r.seconds_boundaries = seconds(t);
-        return r;
+        return inSurface;
     }
 
     /// Per hole region: 1 if it is an undersampling gap to fill, i.e. closed (the implicit
