@@ -208,3 +208,27 @@ def test_filter_script_runs_and_matches_the_filter(plugin, tmp_path):
     params = lambda path: {(p.get("name"), p.get("type"), p.get("value"))
                            for p in ET.parse(path).getroot().iter("Param")}
     assert params(script) == params(tmp_path / "defaults.mlx")
+
+
+def test_an_error_does_not_crash_the_next_mesh_load():
+    """pymeshlab 2025.7 crashes on the next mesh load after a filter raised in a MeshSet that
+    is then deleted (once a plugin was added with load_plugin); apply() and the bound method
+    clear its stale log pointer. Run in a child process: the failure mode is a segfault."""
+    import subprocess
+    import sys
+
+    script = f"""
+import numpy as np, pymeshlab, implicit_boundaries
+implicit_boundaries.load()
+ms = pymeshlab.MeshSet()
+ms.add_mesh(pymeshlab.Mesh(vertex_matrix=np.random.default_rng(0).random((50, 3))))
+try:
+    ms.{FILTER}(resolution=-3)
+except pymeshlab.PyMeshLabException:
+    pass
+del ms
+pymeshlab.MeshSet().load_new_mesh({str(SAMPLES / "bunny.obj")!r})
+print("loaded")
+"""
+    child = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
+    assert child.returncode == 0 and "loaded" in child.stdout, child.stderr[-2000:]
