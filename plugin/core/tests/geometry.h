@@ -12,8 +12,8 @@
 
 namespace ib::test {
 
-/// n samples on the unit-radius sphere around c (Fibonacci spiral: uniform, deterministic),
-/// outward normals. Only those with z >= zmin are kept.
+/// n samples on the sphere of the given radius around the origin (Fibonacci spiral: uniform,
+/// deterministic), with outward normals. Only those with z >= zmin (unit-sphere z) are kept.
 inline void SpherePoints(int n, double radius, Points& P, Points& N, double zmin = -2)
 {
     std::vector<Eigen::Vector3d> ps, ns;
