@@ -17,7 +17,6 @@
 
 #include <array>
 #include <deque>
-#include <unordered_map>
 #include <vector>
 
 namespace ib {
@@ -30,7 +29,9 @@ public:
 
     /// Among the faces f of `mesh` with inSurface[f], removes (sets inSurface[f] = 0) those
     /// reachable from the boundary through unsupported faces. reach: per sample, the largest
-    /// supported distance. Returns the number of faces removed.
+    /// supported distance. Needs the mesh's face-face adjacency (vcg UpdateTopology::FaceFace),
+    /// built once for the whole extraction: surface membership is read from inSurface.
+    /// Returns the number of faces removed.
     static size_t Compute(const CoreMesh& mesh, const SampleIndex& samples, const Eigen::VectorXd& reach,
                           std::vector<char>& inSurface, int threads = 0)
     {
@@ -49,11 +50,14 @@ public:
         SampleIndex::Queue queue;
         auto unsupported = [&](size_t f) { return far[f] && SamplesOnOneSide(mesh.face[f], samples, queue); };
 
-        const std::vector<std::array<int, 3>> across = Neighbours(mesh, inSurface);
         std::deque<int> pending;
         for (size_t f = 0; f < n; ++f)
-            if (inSurface[f] && far[f] && std::count(across[f].begin(), across[f].end(), -1) > 0)
-                pending.push_back(int(f));
+            if (inSurface[f] && far[f])
+                for (int i = 0; i < 3; ++i)
+                    if (Across(mesh, f, i, inSurface) < 0) {
+                        pending.push_back(int(f));
+                        break;
+                    }
         size_t removed = 0;
         while (!pending.empty()) {
             const size_t f = size_t(pending.front());
@@ -62,18 +66,18 @@ public:
                 continue;
             inSurface[f] = 0;
             ++removed;
-            for (int g : across[f])
-                if (g >= 0)
+            for (int i = 0; i < 3; ++i)
+                if (const int g = Across(mesh, f, i, inSurface); g >= 0)
                     pending.push_back(g);
         }
         return removed;
     }
 
     /// Removes (sets inSurface to 0) the connected pieces of surface with fewer than
-    /// `min_faces` faces: the scraps a trim leaves beside a boundary. Returns faces removed.
+    /// `min_faces` faces: the scraps a trim leaves beside a boundary. Needs face-face
+    /// adjacency, as Compute. Returns faces removed.
     static size_t RemoveScraps(const CoreMesh& mesh, std::vector<char>& inSurface, size_t min_faces)
     {
-        const std::vector<std::array<int, 3>> across = Neighbours(mesh, inSurface);
         std::vector<int> piece(mesh.face.size(), -1);
         size_t removed = 0;
         for (size_t seed = 0; seed < mesh.face.size(); ++seed) {
@@ -82,8 +86,8 @@ public:
             std::vector<int> members{int(seed)};
             piece[seed] = int(seed);
             for (size_t i = 0; i < members.size(); ++i)
-                for (int g : across[size_t(members[i])])
-                    if (g >= 0 && piece[size_t(g)] < 0) {
+                for (int e = 0; e < 3; ++e)
+                    if (const int g = Across(mesh, size_t(members[i]), e, inSurface); g >= 0 && piece[size_t(g)] < 0) {
                         piece[size_t(g)] = int(seed);
                         members.push_back(g);
                     }
@@ -122,26 +126,12 @@ private:
         return gap > kOutsideGap;
     }
 
-    /// Per face in the surface: the surface face across each edge, or -1.
-    static std::vector<std::array<int, 3>> Neighbours(const CoreMesh& mesh, const std::vector<char>& inSurface)
+    /// The surface face across edge i of face f, or -1 (a border, or a face not in the surface).
+    static int Across(const CoreMesh& mesh, size_t f, int i, const std::vector<char>& inSurface)
     {
-        std::unordered_map<uint64_t, int> owner;  // directed half-edge a->b -> face
-        auto key = [&](const CoreFace& f, int i) {
-            return uint64_t(vcg::tri::Index(mesh, f.cV(i))) << 32 | uint64_t(vcg::tri::Index(mesh, f.cV((i + 1) % 3)));
-        };
-        auto twin = [](uint64_t k) { return k << 32 | k >> 32; };
-        for (size_t f = 0; f < mesh.face.size(); ++f)
-            if (inSurface[f])
-                for (int i = 0; i < 3; ++i)
-                    owner.emplace(key(mesh.face[f], i), int(f));
-        std::vector<std::array<int, 3>> across(mesh.face.size(), {-1, -1, -1});
-        for (size_t f = 0; f < mesh.face.size(); ++f)
-            if (inSurface[f])
-                for (int i = 0; i < 3; ++i) {
-                    auto it = owner.find(twin(key(mesh.face[f], i)));
-                    across[f][size_t(i)] = it == owner.end() ? -1 : it->second;
-                }
-        return across;
+        const CoreFace* g = mesh.face[f].cFFp(i);
+        const size_t index = vcg::tri::Index(mesh, g);
+        return g == &mesh.face[f] || !inSurface[index] ? -1 : int(index);
     }
 };
 

@@ -14,6 +14,7 @@
 #include "sods.h"
 #include "spacing.h"
 
+#include <vcg/complex/algorithms/update/topology.h>
 #include <vcg/complex/append.h>
 #include <vcg/complex/algorithms/update/selection.h>
 
@@ -215,6 +216,7 @@ public:
             if (fill[size_t(mc.face_region[face - mc.surface_faces])])
                 inSurface[face] = 1;
         r.holes_filled = int(std::count(fill.begin(), fill.end(), 1));
+        vcg::tri::UpdateTopology<CoreMesh>::FaceFace(all);  // once, for the trim and the scraps
         if (p.boundary_trim > 0)
             r.faces_trimmed = BoundaryTrim::Compute(all, samples, p.boundary_trim * spacing, inSurface, p.threads);
         r.faces_unpinched = Pinches::Resolve(all, inSurface);

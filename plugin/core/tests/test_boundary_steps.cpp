@@ -94,6 +94,7 @@ TEST(BoundarySteps, ScrapsBelowTheSizeAreRemoved)
     AddTriangle(m, vcg::Point3d(5, 0, 0), vcg::Point3d(6, 0, 0), vcg::Point3d(5, 1, 0));  // alone
     vcg::tri::Clean<CoreMesh>::RemoveDuplicateVertex(m);
     vcg::tri::Allocator<CoreMesh>::CompactEveryVector(m);
+    vcg::tri::UpdateTopology<CoreMesh>::FaceFace(m);
     std::vector<char> inSurface(7, 1);
     EXPECT_EQ(BoundaryTrim::RemoveScraps(m, inSurface, 2), 1u);
     EXPECT_EQ(inSurface.back(), 0);
