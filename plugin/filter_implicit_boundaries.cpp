@@ -11,6 +11,8 @@ namespace {
 const QStringList kNormalSources = {"Use layer normals", "Estimate"};
 // Order matches ib::Reconstruction::Occupancy.
 const QStringList kOccupancies = {"Tangent disks", "Sample cells (paper)"};
+// Order matches ib::GatedMarchingCubes::Extraction.
+const QStringList kExtractions = {"SODS-driven", "Full lattice, gated", "Plain marching cubes"};
 
 ib::Points vertexMatrix(const CMeshO& m, bool normals)
 {
@@ -174,6 +176,20 @@ RichParameterList FilterImplicitBoundariesPlugin::reconstructionParameters(const
 		"takes the layer's own (a scan's normals are usually best) and estimates them only when "
 		"the layer has none (all zero); 'Estimate' always fits them (PCA over neighbours, "
 		"oriented by propagation). The log says when normals were estimated."));
+	par.addParam(RichEnum(
+		"extraction", int(d.extraction), kExtractions, "Extraction",
+		"'SODS-driven' evaluates the implicit function only at the corners of occupied cells "
+		"(fast, memory grows with the surface). 'Full lattice, gated' evaluates every lattice "
+		"corner first, as the paper's implementation did: same surface, slower. 'Plain marching "
+		"cubes' ignores the occupancy and extracts the whole implicit surface (closed, no "
+		"boundaries): the reference the method is compared with.",
+		true));
+	par.addParam(RichFloat(
+		"memory_limit", d.memory_limit, "Memory limit (GB, 0 = half the RAM)",
+		"A run estimated to need more memory than this is refused before it starts, with a "
+		"message, instead of exhausting the machine. 0 uses half of the physical memory. Lower "
+		"the resolution rather than raising the limit if you can.",
+		true));
 	par.addParam(RichInt(
 		"normal_neighbours", d.normal_neighbours, "Normal estimation neighbours",
 		"Samples used to fit each tangent plane when normals are estimated. Raise it for noisy "
@@ -213,6 +229,8 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 	const bool holeLayer = par.getBool("hole_layer");
 	p.occupancy = ib::Reconstruction::Occupancy(par.getEnum("sods_occupancy"));
 	p.sample_radius = par.getFloat("sample_radius");
+	p.extraction = ib::GatedMarchingCubes::Extraction(par.getEnum("extraction"));
+	p.memory_limit = 1e9 * par.getFloat("memory_limit");
 
 	ib::CoreMesh surface, holes;
 	ib::Reconstruction::Result r;
@@ -266,10 +284,11 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 		"filled (loops under %d edges); %zu unsupported faces trimmed off the boundary.",
 		out->cm.fn, out->cm.vn, int(r.loops.size()), qUtf8Printable(loopSummary(r.loops)),
 		r.holes_filled, p.min_boundary_edges, r.faces_trimmed);
-	log("%zu SODS cells, %zu hole cells%s; %zu implicit evaluations instead of %.0f for the full "
-		"lattice.",
-		r.sods_cells, r.hole_cells, r.hole_search_capped ? " (search capped: larger holes kept open)" : "",
-		r.evaluations, r.lattice_corners);
+	log("%s extraction: %zu SODS cells, %zu hole cells%s; %zu implicit evaluations (the full "
+		"lattice has %.0f corners, the cells the surface crosses %zu).",
+		qUtf8Printable(kExtractions[int(p.extraction)]), r.sods_cells, r.hole_cells,
+		r.hole_search_capped ? " (search capped: larger holes kept open)" : "", r.evaluations,
+		r.lattice_corners, r.crossed_corners);
 
 	std::map<std::string, QVariant> res;
 	res["boundary_loops"] = int(r.loops.size());
@@ -290,6 +309,8 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 	res["sods_cells"] = double(r.sods_cells);
 	res["implicit_evaluations"] = double(r.evaluations);
 	res["full_lattice_evaluations"] = double(r.lattice_corners);
+	res["crossed_cell_corners"] = double(r.crossed_corners);
+	res["memory_limit_gb"] = r.memory_limit / 1e9;
 	res["normals_estimated"] = r.normals_estimated;
 	res["seconds_normals"] = r.seconds_normals;
 	res["seconds_implicit"] = r.seconds_implicit;

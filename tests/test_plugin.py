@@ -180,6 +180,9 @@ def test_bad_layers_raise_clear_errors(plugin, make, message):
     (dict(sods_dilation=-1), "dilation"),
     (dict(sample_radius=0.0), "radius"),
     (dict(normal_neighbours=1), "neighbours"),
+    (dict(memory_limit=-1.0), "memory limit"),
+    (dict(resolution=1500, memory_limit=0.05), "over the limit of 0.05 GB"),
+    (dict(resolution=400, extraction="Full lattice, gated", memory_limit=0.1), "use the SODS-driven"),
 ])
 def test_bad_parameters_raise_clear_errors(plugin, params, message):
     points, normals, _ = point_cloud(SAMPLES / "bunny10k_textured.obj")
@@ -232,3 +235,22 @@ print("loaded")
 """
     child = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
     assert child.returncode == 0 and "loaded" in child.stdout, child.stderr[-2000:]
+
+
+@pytest.mark.parametrize("extraction", ["Full lattice, gated", "Plain marching cubes"])
+def test_extraction_modes_by_name(plugin, extraction):
+    """The full-lattice extractions evaluate every lattice corner; the gated one gives the
+    SODS-driven mesh exactly, plain marching cubes the closed surface (no boundary loops)."""
+    points, normals, _ = point_cloud(SAMPLES / "bunny10k_textured.obj")
+    ms = new_set(points, normals)
+    sparse = getattr(ms, FILTER)()
+    sparse_vertices = ms.current_mesh().vertex_matrix().copy()
+    ms.set_current_mesh(0)
+    full = getattr(ms, FILTER)(extraction=extraction)
+    assert full["implicit_evaluations"] == full["full_lattice_evaluations"] > 5 * sparse["implicit_evaluations"]
+    assert sparse["crossed_cell_corners"] <= sparse["implicit_evaluations"] <= 1.5 * sparse["crossed_cell_corners"]
+    if extraction == "Plain marching cubes":
+        assert full["boundary_loops"] == 0 and full["surface_faces"] > sparse["surface_faces"]
+    else:
+        assert np.array_equal(ms.current_mesh().vertex_matrix(), sparse_vertices)
+        assert full["boundary_loops"] == sparse["boundary_loops"] == 3

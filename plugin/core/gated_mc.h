@@ -5,12 +5,18 @@
 /// Surface triangles are extracted only in SODS cells, evaluating the implicit function only
 /// at the corners of those cells (the "SODS-driven" extraction of paper §3.4: Θ(k) in the
 /// number of SODS cells instead of Θ(m) in the lattice size). Hole triangles are then found by
-/// a breadth-first search from the empty cells next to SODS cells through empty cells that the
-/// implicit surface crosses; they are extracted with the same walker, so they share vertices
+/// a breadth-first search from the SODS cells through empty cells that the implicit surface
+/// crosses, stepping only across cell faces the surface crosses (so only the cells along the
+/// surface are evaluated, not the shell of empty cells around the SODS); they are extracted with the same walker, so they share vertices
 /// with the surface and surface + holes is the closed marching cubes surface. Each connected
 /// set of hole cells is a hole region; a region is closed when the search finished it away
 /// from the lattice border (the implicit surface closes it), open otherwise (the surface runs
 /// off, as at a cut, or the search hit its cap).
+///
+/// Two more extractions serve as references (paper §3.4): the paper's own implementation,
+/// which evaluates every lattice corner and then extracts only in SODS cells (same triangles,
+/// Θ(m) evaluations), and plain marching cubes over the whole lattice (no gate, no holes: the
+/// closed surface the paper compares against).
 ///
 /// Uses VCGlib's topologically consistent vcg::tri::MarchingCubes tables with our own walker,
 /// which serves corner values from batch evaluations and welds the edge vertices of neighbours.
@@ -30,9 +36,16 @@ namespace ib {
 class GatedMarchingCubes
 {
 public:
+    enum class Extraction {
+        SodsDriven,        ///< evaluate only the corners of SODS (and hole) cells
+        FullLatticeGated,  ///< evaluate every lattice corner, extract in SODS cells (the paper's code)
+        Plain              ///< evaluate every lattice corner, extract everywhere (no gate, no holes)
+    };
+
     struct Param
     {
-        bool holes = true;           ///< also extract the hole triangles
+        Extraction extraction = Extraction::SodsDriven;
+        bool holes = true;           ///< also extract the hole triangles (not with Plain)
         size_t max_hole_cells = 0;   ///< cap of the hole search; 0 = max(SODS cells, 4096)
     };
 
@@ -44,6 +57,9 @@ public:
         std::vector<int> face_region;
         std::vector<char> region_closed;  ///< per hole region
         size_t sods_cells = 0, hole_cells = 0, evaluations = 0;
+        /// Distinct corners of the SODS and hole cells the surface crosses: the fewest
+        /// evaluations any extractor of the gated surface and its holes must make.
+        size_t crossed_corners = 0;
         bool hole_search_capped = false;
     };
 
@@ -56,20 +72,24 @@ public:
         CornerValues values(lattice, f);
         const std::vector<Index3> cells = sods.Cells();
         r.sods_cells = cells.size();
-        if (cb) cb(10, "Evaluating the implicit function at SODS corners");
-        values.Evaluate(cells);
-
         Walker walker(lattice, mesh, values);
         vcg::tri::MarchingCubes<CoreMesh, Walker> mc(mesh, walker);
         mc.Initialize();
-        const size_t step = std::max<size_t>(1, cells.size() / 20);
-        for (size_t i = 0; i < cells.size(); ++i) {
-            Process(mc, cells[i]);
-            if (cb && i % step == 0) cb(60 + int(30 * i / cells.size()), "Marching cubes over SODS cells");
+        if (param.extraction == Extraction::SodsDriven) {
+            if (cb) cb(10, "Evaluating the implicit function at SODS corners");
+            values.Evaluate(cells);
+            Extract(mc, cells, cb);
+        } else {
+            values.EvaluateAll(cb);
+            if (param.extraction == Extraction::FullLatticeGated)
+                Extract(mc, cells, cb);
+            else
+                ExtractAll(mc, lattice, cb);
         }
         r.surface_faces = mesh.face.size();
+        std::vector<Index3> crossed = cells;  // and the hole cells, which all are crossed
 
-        if (param.holes) {
+        if (param.holes && param.extraction != Extraction::Plain) {
             if (cb) cb(90, "Searching hole triangles");
             const size_t cap = param.max_hole_cells ? param.max_hole_cells : std::max<size_t>(cells.size(), 4096);
             HoleSearch search(lattice, sods, values, cells, cap);
@@ -81,7 +101,9 @@ public:
                 Process(mc, search.cells[i]);
                 r.face_region.insert(r.face_region.end(), mesh.face.size() - before, search.region[i]);
             }
+            crossed.insert(crossed.end(), search.cells.begin(), search.cells.end());
         }
+        r.crossed_corners = values.CornerCount(crossed, true);
         mc.Finalize();
         r.evaluations = values.Count();
         return r;
@@ -94,6 +116,29 @@ public:
     }
 
 private:
+    /// Marching cubes over `cells` (sorted), with progress from 60 to 90.
+    template <class MarchingCubes>
+    static void Extract(MarchingCubes& mc, const std::vector<Index3>& cells, vcg::CallBackPos* cb)
+    {
+        const size_t step = std::max<size_t>(1, cells.size() / 20);
+        for (size_t i = 0; i < cells.size(); ++i) {
+            Process(mc, cells[i]);
+            if (cb && i % step == 0) cb(60 + int(30 * i / cells.size()), "Marching cubes over SODS cells");
+        }
+    }
+
+    /// Marching cubes over every lattice cell, in the same (z, y, x) order as sorted SODS cells.
+    template <class MarchingCubes>
+    static void ExtractAll(MarchingCubes& mc, const Lattice& lattice, vcg::CallBackPos* cb)
+    {
+        for (int z = 0; z < lattice.cells[2]; ++z) {
+            if (cb) cb(60 + 30 * z / lattice.cells[2], "Marching cubes over the whole lattice");
+            for (int y = 0; y < lattice.cells[1]; ++y)
+                for (int x = 0; x < lattice.cells[0]; ++x)
+                    Process(mc, Index3(x, y, z));
+        }
+    }
+
     template <class MarchingCubes>
     static void Process(MarchingCubes& mc, const Index3& c)
     {
@@ -108,15 +153,33 @@ private:
         return k;
     }
 
-    /// Implicit function values at lattice corners, evaluated in batches, each corner once.
+    /// Implicit function values at lattice corners, evaluated in batches, each corner once:
+    /// sparse (a hash map filled cell set by cell set) or dense (every corner, EvaluateAll).
     class CornerValues
     {
     public:
         CornerValues(const Lattice& l, const ImplicitFunction& f) : lattice_(l), f_(f) {}
 
+        /// Evaluates every lattice corner, one z-slab per batch (the full-lattice extractions).
+        void EvaluateAll(vcg::CallBackPos* cb)
+        {
+            const Index3 n = lattice_.cells + Index3::Ones();
+            dense_.resize(size_t(n[0]) * size_t(n[1]) * size_t(n[2]));
+            Points Q(Eigen::Index(n[0]) * n[1], 3);
+            for (int z = 0; z < n[2]; ++z) {
+                if (cb) cb(10 + 50 * z / n[2], "Evaluating the implicit function on the whole lattice");
+                for (int y = 0; y < n[1]; ++y)
+                    for (int x = 0; x < n[0]; ++x)
+                        Q.row(Eigen::Index(y) * n[0] + x) = lattice_.Corner(x, y, z).transpose();
+                f_.Eval(Q, Eigen::Map<Eigen::VectorXd>(dense_.data() + size_t(z) * size_t(Q.rows()), Q.rows()));
+            }
+        }
+
         /// Evaluates the corners of `cells` that have no value yet (one batch call).
         void Evaluate(const std::vector<Index3>& cells)
         {
+            if (!dense_.empty())
+                return;
             std::vector<uint64_t> keys;
             keys.reserve(cells.size() * 8);
             for (const Index3& c : cells)
@@ -137,7 +200,14 @@ private:
                 values_.emplace(keys[i], out[Eigen::Index(i)]);
         }
 
-        double operator()(uint64_t key) const { return values_.at(key); }
+        double operator()(uint64_t key) const
+        {
+            if (dense_.empty())
+                return values_.at(key);
+            const Index3 v = UnpackIndex(key);
+            const size_t nx = size_t(lattice_.cells[0]) + 1, ny = size_t(lattice_.cells[1]) + 1;
+            return dense_[(size_t(v[2]) * ny + size_t(v[1])) * nx + size_t(v[0])];
+        }
 
         /// True when the surface crosses cell c (its corners are not all on one side).
         bool Crossed(const Index3& c) const
@@ -148,12 +218,46 @@ private:
             return positive != 0 && positive != 8;
         }
 
-        size_t Count() const { return values_.size(); }
+        /// True when the surface crosses the face of cell c towards its neighbour c + step
+        /// (step: a unit axis vector): the face's four corners are not all on one side.
+        bool FaceCrossed(const Index3& c, const Index3& step) const
+        {
+            int axis = 0;
+            while (step[axis] == 0)
+                ++axis;
+            const int a = (axis + 1) % 3, b = (axis + 2) % 3;
+            Index3 v = c;
+            v[axis] += step[axis] > 0;
+            int positive = 0;
+            for (int i = 0; i < 4; ++i) {
+                Index3 corner = v;
+                corner[a] += i & 1;
+                corner[b] += i >> 1;
+                positive += (*this)(PackIndex(corner[0], corner[1], corner[2])) > 0;
+            }
+            return positive != 0 && positive != 4;
+        }
+
+        /// Corners evaluated so far.
+        size_t Count() const { return dense_.empty() ? values_.size() : dense_.size(); }
+
+        /// Distinct corners of `cells` (only of the crossed ones when `crossed`).
+        size_t CornerCount(const std::vector<Index3>& cells, bool crossed) const
+        {
+            std::vector<uint64_t> keys;
+            for (const Index3& c : cells)
+                if (!crossed || Crossed(c))
+                    for (uint64_t k : CornerKeys(c))
+                        keys.push_back(k);
+            std::sort(keys.begin(), keys.end());
+            return size_t(std::unique(keys.begin(), keys.end()) - keys.begin());
+        }
 
     private:
         const Lattice& lattice_;
         const ImplicitFunction& f_;
         std::unordered_map<uint64_t, double> values_;
+        std::vector<double> dense_;
     };
 
     /// Breadth-first search of the hole cells, level by level so that each level's new corners
@@ -172,10 +276,14 @@ private:
                                              Index3(0, -1, 0), Index3(0, 0, 1), Index3(0, 0, -1)};
             std::unordered_set<uint64_t> queued, examined, holes;
             std::vector<Index3> frontier;
+            // The surface passes from a cell to a neighbour only through a face it crosses, so
+            // only neighbours across crossed faces are visited (and evaluated): the search
+            // follows the surface instead of flooding the shell around the SODS.
             auto enqueue = [&](const Index3& c, std::vector<Index3>& into) {
                 for (const Index3& s : kSteps) {
                     const Index3 n = c + s;
-                    if (lattice.ContainsCell(n) && !sods.Contains(n) && queued.insert(Key(n)).second)
+                    if (lattice.ContainsCell(n) && !sods.Contains(n) && values.FaceCrossed(c, s) &&
+                        queued.insert(Key(n)).second)
                         into.push_back(n);
                 }
             };
@@ -186,9 +294,7 @@ private:
                 std::vector<Index3> next;
                 for (const Index3& c : frontier) {
                     examined.insert(Key(c));
-                    if (!values.Crossed(c))
-                        continue;
-                    holes.insert(Key(c));
+                    holes.insert(Key(c));  // entered through a crossed face: the surface is in it
                     if (holes.size() >= cap) {
                         capped = true;
                         break;
@@ -212,6 +318,8 @@ private:
                     const Index3 c = UnpackIndex(stack.back());
                     stack.pop_back();
                     for (const Index3& s : kSteps) {
+                        if (!values.FaceCrossed(c, s))
+                            continue;
                         const Index3 n = c + s;
                         // Open: the surface leaves the lattice, or goes where the search did not look.
                         if (!lattice.ContainsCell(n) || (!sods.Contains(n) && !examined.count(Key(n))))

@@ -9,6 +9,7 @@
 #include "boundary_trim.h"
 #include "gated_mc.h"
 #include "implicit/hoppe.h"
+#include "memory_budget.h"
 #include "normals.h"
 #include "pinches.h"
 #include "sods.h"
@@ -21,6 +22,7 @@
 #include <Eigen/Eigenvalues>
 
 #include <chrono>
+#include <iomanip>
 #include <numeric>
 #include <cmath>
 #include <sstream>
@@ -82,6 +84,9 @@ public:
         /// peeled off (the margin the SODS adds past the scan's edge). 0 = no trim.
         double boundary_trim = 0.5;
         int boundary_smoothing = 4;  ///< iterations of collinearity moves (paper §3.3), 0 = off
+        GatedMarchingCubes::Extraction extraction = GatedMarchingCubes::Extraction::SodsDriven;
+        /// Refuse runs estimated to need more memory (bytes); 0 = half the physical memory.
+        double memory_limit = 0;
         int threads = 0;             ///< 0 = all cores
     };
 
@@ -102,7 +107,9 @@ public:
         Index3 lattice_cells = Index3::Zero();
         size_t sods_cells = 0;
         size_t evaluations = 0;
+        size_t crossed_corners = 0;  ///< corners of the SODS and hole cells the surface crosses
         double lattice_corners = 0;  ///< what a full-lattice extraction would have evaluated
+        double memory_limit = 0;     ///< the budget used, bytes
         bool normals_estimated = false;
         bool normals_flipped = false;
         double seconds_normals = 0, seconds_implicit = 0, seconds_sods = 0, seconds_extraction = 0,
@@ -160,20 +167,28 @@ public:
         r.cell_size = lattice.cell_size;
         r.lattice_cells = lattice.cells;
         r.lattice_corners = lattice.CornerCount();
+        r.memory_limit = p.memory_limit > 0 ? p.memory_limit : MemoryBudget::Default();
+        // Before the SODS: a surface of n samples at spacing s covers about n·s² / cell² cells.
+        const double expectedCells = 2.0 * double(P.rows()) * std::pow(r.sample_spacing / cell, 2);
+        CheckMemory(p.extraction, lattice, expectedCells, r);
         if (cb) cb(8, "Building the spatial occupancy data structure");
         Sods sods = p.occupancy == Occupancy::TangentDisks
                         ? Sods::FromDisks(lattice, P, normals, p.sample_radius * spacing,
-                                          kDiskSlack * lattice.cell_size)
+                                          kDiskSlack * lattice.cell_size, p.threads)
                         : Sods::FromSamples(lattice, P);
         for (int i = 0; i < p.sods_dilation; ++i)
             sods = sods.Dilated();
         r.sods_cells = sods.Count();
         r.seconds_sods = seconds(t);
+        CheckMemory(p.extraction, lattice, double(r.sods_cells), r);
 
         t = Clock::now();
         CoreMesh all;
-        const GatedMarchingCubes::Result mc = GatedMarchingCubes::Compute(lattice, sods, f, all, GatedMarchingCubes::Param(), cb);
+        GatedMarchingCubes::Param mp;
+        mp.extraction = p.extraction;
+        const GatedMarchingCubes::Result mc = GatedMarchingCubes::Compute(lattice, sods, f, all, mp, cb);
         r.evaluations = mc.evaluations;
+        r.crossed_corners = mc.crossed_corners;
         r.hole_cells = mc.hole_cells;
         r.hole_search_capped = mc.hole_search_capped;
         r.seconds_extraction = seconds(t);
@@ -211,6 +226,8 @@ public:
     {
         std::vector<char> inSurface(all.face.size(), 0);
         std::fill(inSurface.begin(), inSurface.begin() + long(mc.surface_faces), 1);
+        if (p.extraction == GatedMarchingCubes::Extraction::Plain)
+            return inSurface;  // the closed reference: nothing to fill, trim or smooth
         const std::vector<int> fill = SmallHoles(all, inSurface, mc, p.min_boundary_edges, r.loops_before_filling);
         for (size_t face = mc.surface_faces; face < all.face.size(); ++face)
             if (fill[size_t(mc.face_region[face - mc.surface_faces])])
@@ -293,6 +310,26 @@ public:
         return N.rows() > 0 && (N.rowwise().squaredNorm().array() > 0).any();
     }
 
+    /// Refuses, before allocating, a run whose estimated peak (from the SODS cells, or from the
+    /// lattice for full-lattice extraction) exceeds r.memory_limit.
+    static void CheckMemory(GatedMarchingCubes::Extraction extraction, const Lattice& lattice, double sodsCells,
+                            const Result& r)
+    {
+        const bool dense = extraction != GatedMarchingCubes::Extraction::SodsDriven;
+        const double bytes = MemoryBudget::ExtractionBytes(sodsCells, dense ? lattice.CornerCount() : 0);
+        if (bytes <= r.memory_limit)
+            return;
+        std::ostringstream msg;
+        msg.precision(2);
+        msg << std::fixed << "Resolution " << r.resolution << " would need about " << bytes / 1e9
+            << " GB of memory " << (dense ? "(the full lattice has " : "(") << std::setprecision(0)
+            << (dense ? lattice.CornerCount() : sodsCells) << (dense ? " corners)" : " occupied cells)")
+            << std::setprecision(2) << ", over the limit of " << r.memory_limit / 1e9
+            << " GB: lower the resolution (0 = automatic)"
+            << (dense ? ", use the SODS-driven extraction" : "") << " or raise the memory limit.";
+        throw InputError(msg.str());
+    }
+
 private:
     static void CheckInput(const Points& P, const Points& N, const Param& p)
     {
@@ -330,6 +367,8 @@ private:
             throw InputError("Boundary smoothing must be between 0 and 100 iterations (4 is the paper's choice).");
         if (!(p.boundary_trim >= 0 && p.boundary_trim <= 8))
             throw InputError("The boundary trim must be between 0 (off) and 8 sample spacings.");
+        if (!(p.memory_limit >= 0))
+            throw InputError("The memory limit cannot be negative (0 = half the physical memory).");
         if (p.min_boundary_edges < 0)
             throw InputError("The minimum number of boundary edges cannot be negative (0 keeps every hole).");
         if (p.normal_neighbours < 3 || p.normal_neighbours > 256)

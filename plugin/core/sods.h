@@ -8,6 +8,7 @@
 /// the occupied cells, not with the lattice volume.
 
 #include "lattice.h"
+#include "parallel.h"
 
 #include <algorithm>
 #include <array>
@@ -35,28 +36,22 @@ public:
     /// thickened by `slack` (world units) on each side along the normal. With radii from the
     /// local sample spacing, sparse regions stay covered while gaps wider than two radii stay open.
     static Sods FromDisks(const Lattice& lattice, const Points& P, const Points& N,
-                          const Eigen::VectorXd& radius, double slack)
+                          const Eigen::VectorXd& radius, double slack, int threads = 0)
     {
-        Sods s(lattice.cells);
-        const double a = 0.5 * lattice.cell_size;
-        for (Eigen::Index i = 0; i < P.rows(); ++i) {
-            const Eigen::Vector3d p = P.row(i).transpose(), n = N.row(i).transpose();
-            const double r = radius[i];
-            const double slab = a * n.cwiseAbs().sum() + slack;
-            const double reach = r + a * std::sqrt(3.0);
-            const Eigen::Vector3d box = Eigen::Vector3d::Constant(std::max(r, slack));
-            const Index3 lo = lattice.CellOf(p - box), hi = lattice.CellOf(p + box);
-            for (int z = lo[2]; z <= hi[2]; ++z)
-                for (int y = lo[1]; y <= hi[1]; ++y)
-                    for (int x = lo[0]; x <= hi[0]; ++x) {
-                        const Eigen::Vector3d d = lattice.Corner(x, y, z) + Eigen::Vector3d::Constant(a) - p;
-                        const double h = n.dot(d);
-                        if (std::abs(h) <= slab && (d - h * n).norm() <= reach)
-                            s.Insert(Index3(x, y, z));
-                    }
-            s.Insert(lattice.CellOf(p));
-        }
-        return s;
+        // One occupancy per block of samples, OR-ed together: the result does not depend on
+        // the thread count.
+        std::vector<Sods> parts;
+        const int blocks = std::max(1, std::min(threads > 0 ? threads : DefaultThreads(), int(P.rows() / 4096)));
+        parts.assign(size_t(blocks), Sods(lattice.cells));
+        const Eigen::Index per = (P.rows() + blocks - 1) / blocks;
+        ParallelFor(size_t(blocks), blocks, [&](size_t begin, size_t end, int) {
+            for (size_t b = begin; b < end; ++b)
+                for (Eigen::Index i = Eigen::Index(b) * per; i < std::min(P.rows(), Eigen::Index(b + 1) * per); ++i)
+                    parts[b].InsertDisk(lattice, P.row(i).transpose(), N.row(i).transpose(), radius[i], slack);
+        }, 1);
+        for (size_t b = 1; b < parts.size(); ++b)
+            parts[0].Merge(parts[b]);
+        return std::move(parts[0]);
     }
 
     void Insert(const Index3& c)
@@ -78,6 +73,37 @@ public:
             return false;
         const int bit = BitOf(c);
         return it->second[bit >> 6] & (uint64_t(1) << (bit & 63));
+    }
+
+    /// Adds the cells of one tangent disk (see FromDisks).
+    void InsertDisk(const Lattice& lattice, const Eigen::Vector3d& p, const Eigen::Vector3d& n, double r, double slack)
+    {
+        const double a = 0.5 * lattice.cell_size;
+        const double slab = a * n.cwiseAbs().sum() + slack;
+        const double reach = r + a * std::sqrt(3.0);
+        const Eigen::Vector3d box = Eigen::Vector3d::Constant(std::max(r, slack));
+        const Index3 lo = lattice.CellOf(p - box), hi = lattice.CellOf(p + box);
+        for (int z = lo[2]; z <= hi[2]; ++z)
+            for (int y = lo[1]; y <= hi[1]; ++y)
+                for (int x = lo[0]; x <= hi[0]; ++x) {
+                    const Eigen::Vector3d d = lattice.Corner(x, y, z) + Eigen::Vector3d::Constant(a) - p;
+                    const double h = n.dot(d);
+                    if (std::abs(h) <= slab && (d - h * n).norm() <= reach)
+                        Insert(Index3(x, y, z));
+                }
+        Insert(lattice.CellOf(p));
+    }
+
+    /// Adds every cell of `other` (same lattice).
+    void Merge(const Sods& other)
+    {
+        for (const auto& [key, brick] : other.bricks_) {
+            Brick& b = bricks_[key];
+            for (size_t w = 0; w < b.size(); ++w) {
+                count_ += size_t(__builtin_popcountll(brick[w] & ~b[w]));
+                b[w] |= brick[w];
+            }
+        }
     }
 
     /// Number of occupied cells.

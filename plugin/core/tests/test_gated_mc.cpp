@@ -115,3 +115,74 @@ TEST(GatedMarchingCubes, HoleRegionReachingTheLatticeBorderIsOpen)
     ASSERT_EQ(r.region_closed.size(), 1u);
     EXPECT_FALSE(r.region_closed[0]);
 }
+
+namespace {
+using Triangle = std::array<std::array<double, 3>, 3>;
+
+// The faces of m as vertex position triples, rotated to start at the smallest vertex (same
+// orientation), optionally only those whose centroid lies in a cell of `within`.
+std::vector<Triangle> Triangles(const CoreMesh& m, const Lattice& l, const Sods* within = nullptr)
+{
+    std::vector<Triangle> out;
+    for (const auto& f : m.face) {
+        const vcg::Point3d centre = vcg::Barycenter(f);
+        if (within && !within->Contains(l.CellOf(Eigen::Vector3d(centre[0], centre[1], centre[2]))))
+            continue;
+        Triangle t;
+        for (int k = 0; k < 3; ++k)
+            t[size_t(k)] = {f.cP(k)[0], f.cP(k)[1], f.cP(k)[2]};
+        std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
+        out.push_back(t);
+    }
+    std::sort(out.begin(), out.end());
+    return out;
+}
+} // namespace
+
+TEST(GatedMarchingCubes, TheThreeExtractionsAgreeInSodsCells)
+{
+    // A sphere gated by a tilted slab: open surface, two hole regions.
+    const Lattice l = Lattice::Fit(Eigen::Vector3d(-1, -1, -1), Eigen::Vector3d(1, 1, 1), 22, 2);
+    Sods slab(l.cells);
+    AllCells(l).ForEach([&](const Index3& c) {
+        const Eigen::Vector3d centre = l.Corner(c[0], c[1], c[2]) + Eigen::Vector3d::Constant(0.5 * l.cell_size);
+        if (std::abs(centre[0] + 0.3 * centre[2]) < 0.6)
+            slab.Insert(c);
+    });
+    const test::SphereDistance sphere(0.9);
+    CoreMesh sparse, full, plain;
+    GatedMarchingCubes::Param p;
+    const auto rs = GatedMarchingCubes::Compute(l, slab, sphere, sparse, p);
+    p.extraction = GatedMarchingCubes::Extraction::FullLatticeGated;
+    const auto rf = GatedMarchingCubes::Compute(l, slab, sphere, full, p);
+    p.extraction = GatedMarchingCubes::Extraction::Plain;
+    const auto rp = GatedMarchingCubes::Compute(l, slab, sphere, plain, p);
+
+    EXPECT_EQ(rf.evaluations, size_t(l.CornerCount()));
+    EXPECT_EQ(rp.evaluations, size_t(l.CornerCount()));
+    EXPECT_LT(rs.evaluations, rf.evaluations);
+    // The sparse extraction evaluates the corners of the SODS cells and of the hole cells,
+    // no more than a cell's layer beyond the crossed cells.
+    EXPECT_GE(rs.evaluations, rs.crossed_corners);
+    EXPECT_EQ(rs.crossed_corners, rf.crossed_corners);
+
+    // Same mesh, same order, for the two gated extractions (surface and holes).
+    ASSERT_EQ(sparse.vert.size(), full.vert.size());
+    ASSERT_EQ(sparse.face.size(), full.face.size());
+    EXPECT_EQ(rs.surface_faces, rf.surface_faces);
+    EXPECT_EQ(rs.face_region, rf.face_region);
+    for (size_t i = 0; i < sparse.vert.size(); ++i)
+        ASSERT_EQ(sparse.vert[i].cP(), full.vert[i].cP()) << i;
+
+    // Plain marching cubes: the closed sphere; its triangles in SODS cells are the surface's.
+    EXPECT_EQ(rp.surface_faces, plain.face.size());
+    EXPECT_TRUE(rp.face_region.empty());
+    EXPECT_EQ(test::Check(plain).border_edges, 0);
+    CoreMesh surfaceOnly;
+    p.extraction = GatedMarchingCubes::Extraction::SodsDriven;
+    p.holes = false;
+    GatedMarchingCubes::Compute(l, slab, sphere, surfaceOnly, p);
+    const auto gated = Triangles(surfaceOnly, l);
+    ASSERT_GT(gated.size(), 100u);
+    EXPECT_EQ(Triangles(plain, l, &slab), gated);
+}

@@ -114,3 +114,65 @@ TEST(Reconstruction, SameOutputOnOneAndTwoThreads)
     ASSERT_EQ(r1.loops.size(), r2.loops.size());
     EXPECT_EQ(r1.loops[0].vertices, r2.loops[0].vertices);
 }
+
+TEST(Reconstruction, FullLatticeExtractionsMatchTheSodsDrivenOne)
+{
+    Points P, N;
+    test::SpherePoints(3000, 1.0, P, N, -0.3);
+    Reconstruction::Param sparse, full, plain;
+    full.extraction = GatedMarchingCubes::Extraction::FullLatticeGated;
+    plain.extraction = GatedMarchingCubes::Extraction::Plain;
+    CoreMesh ms, mf, mp;
+    const auto rs = Reconstruction::Compute(P, N, sparse, ms);
+    const auto rf = Reconstruction::Compute(P, N, full, mf);
+    const auto rp = Reconstruction::Compute(P, N, plain, mp);
+    EXPECT_EQ(rf.evaluations, size_t(rf.lattice_corners));
+    EXPECT_LT(rs.evaluations, rf.evaluations / 4);
+    ASSERT_EQ(ms.vert.size(), mf.vert.size());
+    for (size_t i = 0; i < ms.vert.size(); ++i)
+        ASSERT_EQ(ms.vert[i].cP(), mf.vert[i].cP()) << i;
+    ASSERT_EQ(rs.loops.size(), 1u);
+    ASSERT_EQ(rf.loops.size(), 1u);
+    // No gate: the tangent planes of the rim carry the surface on to the lattice's border,
+    // where its only boundary is.
+    EXPECT_GT(mp.fn, ms.fn);
+    vcg::tri::UpdateBounding<CoreMesh>::Box(mp);
+    ASSERT_FALSE(rp.loops.empty());
+    for (const auto& loop : rp.loops)
+        for (int v : loop.vertices) {
+            const vcg::Point3d q = mp.vert[size_t(v)].cP();
+            double toBorder = 1e9;
+            for (int a = 0; a < 3; ++a)
+                toBorder = std::min({toBorder, q[a] - mp.bbox.min[a], mp.bbox.max[a] - q[a]});
+            EXPECT_LT(toBorder, rp.cell_size) << v;
+        }
+}
+
+TEST(Reconstruction, RefusesRunsOverTheMemoryLimit)
+{
+    Points P, N;
+    test::SpherePoints(2000, 1.0, P, N);
+    Reconstruction::Param p;
+    p.resolution = 400;
+    p.memory_limit = 50e6;  // 50 MB: too little for 400 cells per side
+    CoreMesh m;
+    try {
+        Reconstruction::Compute(P, N, p, m);
+        FAIL() << "no error";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("over the limit of 0.05 GB"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("lower the resolution"), std::string::npos);
+    }
+    p.resolution = 40;  // fits the same limit sparsely, but not as a full lattice of that size
+    EXPECT_NO_THROW(Reconstruction::Compute(P, N, p, m));
+    p.extraction = GatedMarchingCubes::Extraction::FullLatticeGated;
+    p.resolution = 200;
+    p.memory_limit = 30e6;
+    try {
+        Reconstruction::Compute(P, N, p, m);
+        FAIL() << "no error";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("full lattice"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("SODS-driven"), std::string::npos);
+    }
+}

@@ -1,3 +1,4 @@
+#include "geometry.h"
 #include "sods.h"
 
 #include <Eigen/Geometry>
@@ -115,4 +116,16 @@ TEST(Sods, TangentDisksOfUniformSamplesLeaveNoGapAtFineCells)
                 }
             }
     EXPECT_GT(crossed, 2000);
+}
+
+TEST(Sods, TangentDisksAreTheSameOnOneAndTwoThreads)
+{
+    Points P, N;
+    test::SpherePoints(20000, 1.0, P, N);
+    const Lattice l = Lattice::Fit(Eigen::Vector3d(-1, -1, -1), Eigen::Vector3d(1, 1, 1), 80, 3);
+    const Eigen::VectorXd r = Eigen::VectorXd::Constant(P.rows(), 0.03);
+    const Sods one = Sods::FromDisks(l, P, N, r, 0.01, 1), two = Sods::FromDisks(l, P, N, r, 0.01, 2);
+    EXPECT_GT(one.Count(), 10000u);
+    EXPECT_EQ(one.Count(), two.Count());
+    EXPECT_EQ(one.Cells(), two.Cells());
 }

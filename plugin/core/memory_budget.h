@@ -1,0 +1,34 @@
+#pragma once
+/// \file memory_budget.h
+/// How much memory a reconstruction may use, and how much an extraction will need, so that a
+/// run that cannot fit is refused with a message instead of being killed mid-way (which, in
+/// MeshLab, loses the user's unsaved work).
+
+#include <unistd.h>
+
+namespace ib {
+
+struct MemoryBudget
+{
+    /// Peak bytes per SODS cell of a SODS-driven run: corner values and welded edge vertices
+    /// (hash maps), the extracted vertices and faces with adjacency, the split copies and the
+    /// host's copy of the result. Measured (peak RSS over SODS cells) on bun_zipper and a
+    /// synthetic 1M-sample scan; rounded up.
+    static constexpr double kBytesPerSodsCell = 600;
+
+    /// Half the physical memory: room for the host application and its other layers.
+    static double Default()
+    {
+        const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
+        return pages > 0 && page > 0 ? 0.5 * double(pages) * double(page) : 4e9;
+    }
+
+    /// Estimated peak bytes of an extraction over `sodsCells` cells, plus a dense array of
+    /// `denseCorners` values (0 for the SODS-driven extraction).
+    static double ExtractionBytes(double sodsCells, double denseCorners)
+    {
+        return kBytesPerSodsCell * sodsCells + 8.0 * denseCorners;
+    }
+};
+
+} // namespace ib
