@@ -17,6 +17,7 @@
 
 #include <vcg/complex/algorithms/update/topology.h>
 #include <vcg/complex/append.h>
+#include <vcg/complex/algorithms/clean.h>
 #include <vcg/complex/algorithms/update/selection.h>
 
 #include <Eigen/Eigenvalues>
@@ -183,10 +184,12 @@ public:
         CheckMemory(p.extraction, lattice, double(r.sods_cells), r);
 
         t = Clock::now();
-        CoreMesh all;
+        // Extracted straight into `surface`: the hole faces are split off at the end, so a large
+        // run never holds two copies of its mesh.
+        surface.Clear();
         GatedMarchingCubes::Param mp;
         mp.extraction = p.extraction;
-        const GatedMarchingCubes::Result mc = GatedMarchingCubes::Compute(lattice, sods, f, all, mp, cb);
+        const GatedMarchingCubes::Result mc = GatedMarchingCubes::Compute(lattice, sods, f, surface, mp, cb);
         r.evaluations = mc.evaluations;
         r.crossed_corners = mc.crossed_corners;
         r.hole_cells = mc.hole_cells;
@@ -195,10 +198,10 @@ public:
 
         t = Clock::now();
         if (cb) cb(97, "Tracing boundary loops, filling small holes");
-        const std::vector<char> inSurface = Boundaries(all, mc, samples, spacing, f, lattice.cell_size, p, r);
-        Split(all, inSurface, 1, surface);
+        const std::vector<char> inSurface = Boundaries(surface, mc, samples, spacing, f, lattice.cell_size, p, r);
         if (holes)
-            Split(all, inSurface, 0, *holes);
+            Split(surface, inSurface, 0, *holes);
+        KeepSurface(surface, inSurface);
         r.loops = BoundaryLoops::Compute(surface);
         r.seconds_boundaries = seconds(t);
         return r;
@@ -268,6 +271,17 @@ public:
         for (size_t i = 0; i < fill.size(); ++i)
             fill[i] = fill[i] && touched[i];
         return fill;
+    }
+
+    /// Deletes the faces f of `mesh` with !inSurface[f] and the vertices they alone used;
+    /// compacts, keeping the order of what remains.
+    static void KeepSurface(CoreMesh& mesh, const std::vector<char>& inSurface)
+    {
+        for (size_t face = 0; face < mesh.face.size(); ++face)
+            if (!inSurface[face])
+                vcg::tri::Allocator<CoreMesh>::DeleteFace(mesh, mesh.face[face]);
+        vcg::tri::Clean<CoreMesh>::RemoveUnreferencedVertex(mesh);
+        vcg::tri::Allocator<CoreMesh>::CompactEveryVector(mesh);
     }
 
     /// Copies the faces f of `all` with inSurface[f] == which, and their vertices, into `out`.
