@@ -309,7 +309,8 @@ def compare(input, ground_truth=None, *, resolution: int = 0, depth: Optional[in
     result = Comparison(rows, surfaces, cloud, settings)
     if report is not None:
         from .report import write_report  # pyvista and matplotlib only when pictures are asked for
-        result.report = write_report(result, Path(report), truth, lambda what: tell(steps - 2, steps, what))
+        stage = iter(range(steps - 2, steps))
+        result.report = write_report(result, Path(report), truth, lambda what: tell(next(stage), steps, what))
         tell(steps, steps, "done")
     return result
 

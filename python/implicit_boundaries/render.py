@@ -15,9 +15,10 @@ from . import metrics
 
 SURFACE = "#d8c9a8"      # faces near the samples
 UNSUPPORTED = "#e07b39"  # faces farther than 2 sample spacings from every sample
-HOLES = "#3d85c6"        # triangles closing the kept holes (not part of the output)
+HOLES = "#3d85c6"        # our hole triangles (a separate layer, not part of the output)
 BOUNDARY = "#c0162c"
 PANEL = (520, 480)       # pixels per view
+LEGEND_ROW = 0.2         # height of the legend strip, in views
 
 
 def _polydata(vertices: np.ndarray, faces: np.ndarray) -> pv.PolyData:
@@ -45,8 +46,29 @@ def view_directions(points: np.ndarray, boundary: np.ndarray) -> List[np.ndarray
 
 
 def _up(direction: np.ndarray) -> np.ndarray:
-    """y (scans are often y-up), or z when looking along y."""
-    return np.array([0.0, 1.0, 0.0]) if abs(direction[1]) < 0.8 else np.array([0.0, 0.0, 1.0])
+    """y (scans are often y-up), or z when looking along y; made perpendicular to the direction."""
+    up = np.array([0.0, 1.0, 0.0]) if abs(direction[1]) < 0.8 else np.array([0.0, 0.0, 1.0])
+    up = up - (up @ direction) * direction
+    return up / np.linalg.norm(up)
+
+
+def _frame(plotter: pv.Plotter, corners: np.ndarray, direction: np.ndarray, aspect: float) -> None:
+    """Points the active camera along -direction with a parallel projection that just holds the
+    (8, 3) bounding-box corners: the same framing in every panel, whatever the shape."""
+    up = _up(direction)
+    right = np.cross(up, direction)
+    x, y = corners @ right, corners @ up
+    centre = corners.mean(axis=0)
+    centre = centre + right * (0.5 * (x.max() + x.min()) - centre @ right) + up * (0.5 * (y.max() + y.min()) - centre @ up)
+    reach = float(np.ptp(corners @ direction)) + float(np.linalg.norm(np.ptp(corners, axis=0)))
+    camera = plotter.camera
+    camera.enable_parallel_projection()
+    camera.focal_point = centre
+    camera.position = centre + reach * direction
+    camera.up = up
+    # Room for the title above, 4% margin elsewhere.
+    camera.parallel_scale = 1.08 * max(0.5 * np.ptp(y) / 0.88, 0.5 * np.ptp(x) / aspect)
+    camera.clipping_range = (1e-3 * reach, 3 * reach)
 
 
 def side_by_side(panels: Sequence[Tuple[str, np.ndarray, np.ndarray, np.ndarray, object]],
@@ -60,12 +82,16 @@ def side_by_side(panels: Sequence[Tuple[str, np.ndarray, np.ndarray, np.ndarray,
     boundaries = [(v, metrics.boundary_edges(f)) for _, v, f, _, _ in panels]
     first = next((v[np.unique(e)] for v, e in boundaries if len(e)), np.zeros((0, 3)))
     directions = view_directions(points, first)
-    lo, hi = points.min(axis=0), points.max(axis=0)
-    centre, diagonal = 0.5 * (lo + hi), float(np.linalg.norm(hi - lo))
-    bounds = [b for pair in zip(lo - 0.02 * diagonal, hi + 0.02 * diagonal) for b in pair]
+    shown = np.concatenate([points] + [v[np.unique(f)] for _, v, f, _, _ in panels if len(f)]
+                           + [h[0][np.unique(h[1])] for *_, h in panels if h is not None and len(h[1])])
+    lo, hi = shown.min(axis=0), shown.max(axis=0)
+    corners = np.array([[(lo, hi)[i >> k & 1][k] for k in range(3)] for i in range(8)])
 
-    plotter = pv.Plotter(shape=(len(directions), len(panels)), off_screen=True, border=False,
-                         window_size=(PANEL[0] * len(panels), PANEL[1] * len(directions)))
+    # A row per view, then a strip across all columns for the legend.
+    rows = len(directions)
+    plotter = pv.Plotter(shape=(rows + 1, len(panels)), row_weights=[1] * rows + [LEGEND_ROW],
+                         groups=[(rows, np.s_[:])], off_screen=True, border=False,
+                         window_size=(PANEL[0] * len(panels), int(PANEL[1] * (rows + LEGEND_ROW))))
     plotter.set_background("white")
     for row, direction in enumerate(directions):
         for column, ((title, vertices, faces, supported, holes), (_, edges)) in enumerate(zip(panels, boundaries)):
@@ -82,17 +108,12 @@ def side_by_side(panels: Sequence[Tuple[str, np.ndarray, np.ndarray, np.ndarray,
             if row == 0:
                 loops = len(metrics.boundary_vertex_sets(faces, len(vertices)))
                 plotter.add_text(f"{title}\n{len(faces)} faces, {loops} boundary loops", font_size=11, color="black")
-            plotter.camera.focal_point = centre
-            plotter.camera.position = centre + 2.5 * diagonal * direction
-            plotter.camera.up = _up(direction)
-            plotter.renderer.ResetCamera(bounds)
-            plotter.camera.zoom(1.35)  # ResetCamera fits the bounding sphere, leaving wide margins
-    if len(directions) > 1:
-        plotter.subplot(1, 0)
-        plotter.add_legend([["hole-filling triangles (ours, not in its output)", HOLES],
-                            ["faces farther than 2 sample spacings from every sample", UNSUPPORTED],
-                            ["boundary edges", BOUNDARY]], bcolor="white", size=(0.56, 0.12), loc="lower left",
-                           face="rectangle")
+            _frame(plotter, corners, direction, PANEL[0] / PANEL[1])
+    plotter.subplot(rows, 0)
+    plotter.add_legend([["our hole triangles (a separate layer, not in the output)", HOLES],
+                        ["faces farther than 2 sample spacings from every sample", UNSUPPORTED],
+                        ["boundary edges", BOUNDARY]], bcolor="white", border=False, size=(0.42, 0.8),
+                       loc="center", face="rectangle")
     plotter.screenshot(str(path))
     plotter.close()
     return path
