@@ -52,15 +52,15 @@ def _up(direction: np.ndarray) -> np.ndarray:
     return up / np.linalg.norm(up)
 
 
-def _frame(plotter: pv.Plotter, corners: np.ndarray, direction: np.ndarray, aspect: float) -> None:
+def _frame(plotter: pv.Plotter, shown: np.ndarray, direction: np.ndarray, aspect: float) -> None:
     """Points the active camera along -direction with a parallel projection that just holds the
-    (8, 3) bounding-box corners: the same framing in every panel, whatever the shape."""
+    (k, 3) points `shown` (of every panel): the same framing in every panel, whatever the shape."""
     up = _up(direction)
     right = np.cross(up, direction)
-    x, y = corners @ right, corners @ up
-    centre = corners.mean(axis=0)
+    x, y = shown @ right, shown @ up
+    centre = shown.mean(axis=0)
     centre = centre + right * (0.5 * (x.max() + x.min()) - centre @ right) + up * (0.5 * (y.max() + y.min()) - centre @ up)
-    reach = float(np.ptp(corners @ direction)) + float(np.linalg.norm(np.ptp(corners, axis=0)))
+    reach = float(np.ptp(shown @ direction)) + float(np.linalg.norm(np.ptp(shown, axis=0)))
     camera = plotter.camera
     camera.enable_parallel_projection()
     camera.focal_point = centre
@@ -84,8 +84,6 @@ def side_by_side(panels: Sequence[Tuple[str, np.ndarray, np.ndarray, np.ndarray,
     directions = view_directions(points, first)
     shown = np.concatenate([points] + [v[np.unique(f)] for _, v, f, _, _ in panels if len(f)]
                            + [h[0][np.unique(h[1])] for *_, h in panels if h is not None and len(h[1])])
-    lo, hi = shown.min(axis=0), shown.max(axis=0)
-    corners = np.array([[(lo, hi)[i >> k & 1][k] for k in range(3)] for i in range(8)])
 
     # A row per view, then a strip across all columns for the legend.
     rows = len(directions)
@@ -108,11 +106,11 @@ def side_by_side(panels: Sequence[Tuple[str, np.ndarray, np.ndarray, np.ndarray,
             if row == 0:
                 loops = len(metrics.boundary_vertex_sets(faces, len(vertices)))
                 plotter.add_text(f"{title}\n{len(faces)} faces, {loops} boundary loops", font_size=11, color="black")
-            _frame(plotter, corners, direction, PANEL[0] / PANEL[1])
+            _frame(plotter, shown, direction, PANEL[0] / PANEL[1])
     plotter.subplot(rows, 0)
     plotter.add_legend([["our hole triangles (a separate layer, not in the output)", HOLES],
                         ["faces farther than 2 sample spacings from every sample", UNSUPPORTED],
-                        ["boundary edges", BOUNDARY]], bcolor="white", border=False, size=(0.42, 0.8),
+                        ["boundary edges", BOUNDARY]], bcolor="white", border=False, size=(0.34, 0.7),
                        loc="center", face="rectangle")
     plotter.screenshot(str(path))
     plotter.close()
