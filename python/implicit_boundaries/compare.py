@@ -133,13 +133,14 @@ class Comparison:
 
     rows: one dict per method (see :data:`COLUMNS` for the keys and their meaning; truth-based
     keys are missing without a ground truth); surfaces: each method's output by name;
-    settings: what the methods ran with (resolution and depth resolved); report: the folder
-    written, if any.
+    settings: what the methods ran with (resolution and depth resolved); sources: where the
+    input and the ground truth came from; report: report.html, when one was written.
     """
     rows: List[Dict[str, object]]
     surfaces: Dict[str, Surface]
     cloud: Cloud
     settings: Settings
+    sources: Dict[str, str] = field(default_factory=dict)
     report: Optional[Path] = None
 
     def table(self) -> str:
@@ -306,11 +307,14 @@ def compare(input, ground_truth=None, *, resolution: int = 0, depth: Optional[in
         row.update(measure(surface, cloud, truth, truth_loops, loop_tolerance, samples))
         rows.append(row)
 
-    result = Comparison(rows, surfaces, cloud, settings)
+    sources = {"input": str(input) if isinstance(input, (str, Path)) else f"{len(cloud.points)} points given as arrays",
+               "ground truth": "none" if truth is None else str(ground_truth)
+               if isinstance(ground_truth, (str, Path)) else "given as arrays"}
+    result = Comparison(rows, surfaces, cloud, settings, sources)
     if report is not None:
         from .report import write_report  # pyvista and matplotlib only when pictures are asked for
         stage = iter(range(steps - 2, steps))
-        result.report = write_report(result, Path(report), truth, lambda what: tell(next(stage), steps, what))
+        result.report = write_report(result, Path(report), lambda what: tell(next(stage), steps, what))
         tell(steps, steps, "done")
     return result
 

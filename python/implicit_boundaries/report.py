@@ -1,8 +1,9 @@
 """The comparison report: report.html beside its pictures and each method's mesh."""
 import html
 import re
+from importlib import metadata
 from pathlib import Path
-from typing import Callable, Optional, Tuple
+from typing import Callable
 
 import numpy as np
 import pymeshlab
@@ -33,8 +34,7 @@ def _table(comparison: Comparison) -> str:
     return f"<table><tr>{head}</tr>{body}</table>"
 
 
-def write_report(comparison: Comparison, folder: Path, truth: Optional[Tuple[np.ndarray, np.ndarray]] = None,
-                 progress: Callable[[str], None] = lambda what: None) -> Path:
+def write_report(comparison: Comparison, folder: Path, progress: Callable[[str], None] = lambda what: None) -> Path:
     """Writes folder/report.html, its two pictures and a PLY per method; returns the HTML path."""
     folder.mkdir(parents=True, exist_ok=True)
     cloud = comparison.cloud
@@ -48,8 +48,9 @@ def write_report(comparison: Comparison, folder: Path, truth: Optional[Tuple[np.
     progress("charting")
     render.metrics_chart(comparison.rows, folder / CHART)
 
-    parameters = {"samples": len(cloud.points), "bounding-box diagonal": f"{cloud.diagonal:.4g}",
-                  "ground truth": "given" if truth is not None else "none"}
+    parameters = dict(comparison.sources)
+    parameters.update({"samples": len(cloud.points), "bounding-box diagonal": f"{cloud.diagonal:.4g}",
+                       "median sample spacing": f"{cloud.spacing:.4g}", "pymeshlab": metadata.version("pymeshlab")})
     parameters.update(settings_dict(comparison.settings))
     meshes = " · ".join(f'<a href="{slug(n)}.ply">{html.escape(n)}</a>' for n in comparison.surfaces)
     page = f"""<!DOCTYPE html>
