@@ -15,10 +15,10 @@ from pathlib import Path
 
 import numpy as np
 import pymeshlab
-from scipy.spatial import cKDTree
 
 import implicit_boundaries
-from implicit_boundaries.metrics import boundary_vertex_sets, match_loops
+from implicit_boundaries.compare import density_trim, poisson_depth
+from implicit_boundaries.metrics import boundary_distance, boundary_vertex_sets, loops_found
 
 DEFAULT_DATA = Path(__file__).resolve().parent.parent.parent / "shared" / "data"
 CASES = ["bun_zipper.ply", "mech-holes-shark.off", "fandisk_truncated.off", "tum_rabbit.ply", "gargoyle.ply"]
@@ -51,29 +51,16 @@ def run(points, normals, truth, resolution, params):
     out = implicit_boundaries.apply(ms, resolution=resolution, **params)
     seconds = time.perf_counter() - t
     vertices = ms.current_mesh().vertex_matrix()
-    loops = implicit_boundaries.loops_from_result(out)
-    matched = match_loops(truth, [vertices[l] for l in loops], 2.5 * out["sample_spacing"] + 2 * out["cell_size"])
-    # A true boundary counts as found when its largest assigned loop has at least 10 edges.
-    found = sum(max(len(loops[i]) for i in ids) >= 10 for ids in matched.values())
-    assigned = {i for ids in matched.values() for i in ids}
-    spurious = [len(l) for i, l in enumerate(loops) if i not in assigned]
-    return out, seconds, found, spurious, boundary_distance(truth, [vertices[l] for l in loops])
-
-
-def boundary_distance(truth, loops):
-    """Symmetric mean distance between the true boundary points and the output loop points
-    (DESIGN.md section 5), or nan when one side has none."""
-    if not truth or not loops:
-        return float("nan") if truth or loops else 0.0
-    t, o = np.concatenate(truth), np.concatenate(loops)
-    return 0.5 * (cKDTree(o).query(t)[0].mean() + cKDTree(t).query(o)[0].mean())
+    loops = [vertices[l] for l in implicit_boundaries.loops_from_result(out)]
+    found, spurious = loops_found(truth, loops, 2.5 * out["sample_spacing"] + 2 * out["cell_size"])
+    return out, seconds, found, spurious, boundary_distance(truth, loops)
 
 
 def poisson_seconds(points, normals, resolution):
     ms = pymeshlab.MeshSet()
     ms.add_mesh(pymeshlab.Mesh(vertex_matrix=points, v_normals_matrix=normals), "points")
     t = time.perf_counter()
-    ms.generate_surface_reconstruction_screened_poisson(depth=int(round(np.log2(resolution))))
+    ms.generate_surface_reconstruction_screened_poisson(depth=poisson_depth(resolution))
     return time.perf_counter() - t
 
 
@@ -85,13 +72,12 @@ def reference_loops(name, points, normals, resolution):
     if name == "ball pivoting":
         ms.generate_surface_reconstruction_ball_pivoting()
     else:
-        ms.generate_surface_reconstruction_screened_poisson(depth=int(round(np.log2(resolution))))
+        ms.generate_surface_reconstruction_screened_poisson(depth=poisson_depth(resolution))
     seconds = time.perf_counter() - t
     m = ms.current_mesh()
     vertices, faces = m.vertex_matrix(), m.face_matrix()
     if name == "screened Poisson + 5% density trim":
-        density = m.vertex_scalar_array()  # Poisson stores its sample density as vertex quality
-        faces = faces[np.all(density[faces] >= np.quantile(density, 0.05), axis=1)]
+        faces = density_trim(faces, m.vertex_scalar_array(), 0.05)  # Poisson's density is the vertex quality
     return [vertices[h] for h in boundary_vertex_sets(faces, len(vertices))], seconds
 
 
@@ -108,11 +94,8 @@ def references(args):
             rows = [("ours", ours["boundary_loops"], found, spurious, distance)]
             for method in ["screened Poisson", "screened Poisson + 5% density trim", "ball pivoting"]:
                 loops, _ = reference_loops(method, points, normals, ours["resolution"])
-                tolerance = 2.5 * ours["sample_spacing"] + 2 * ours["cell_size"]
-                matched = match_loops(truth, loops, tolerance)
-                assigned = {i for ids in matched.values() for i in ids}
-                rows.append((method, len(loops), sum(max(len(loops[i]) for i in ids) >= 10 for ids in matched.values()),
-                             [len(l) for i, l in enumerate(loops) if i not in assigned], boundary_distance(truth, loops)))
+                found, spurious = loops_found(truth, loops, 2.5 * ours["sample_spacing"] + 2 * ours["cell_size"])
+                rows.append((method, len(loops), found, spurious, boundary_distance(truth, loops)))
             for method, count, found, spurious, distance in rows:
                 print(f"| {name} | {label} | {method} | {count} ({len(truth)}) | {found}/{len(truth)} "
                       f"| {sum(s >= 10 for s in spurious)} / {len(spurious)} | {100 * distance / diagonal:.3f} |")

@@ -1,17 +1,110 @@
 """The command line, called in-process."""
 import pymeshlab
+import pytest
 
-from implicit_boundaries.cli import main
+from implicit_boundaries.cli import DEMO_SCAN, main
+from test_compare import two_holed_sphere
 
 
-def test_demo_writes_the_bunny_and_reports_its_loops(tmp_path, capsys, plugin):
-    out = tmp_path / "bunny.ply"
-    assert main(["demo", "-o", str(out)]) == 0
+def one_error_line(capsys) -> str:
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("implicit-boundaries: error: ")
+    return err[0]
+
+
+def test_demo_writes_the_bunny_compares_it_and_says_where(tmp_path, capsys, plugin):
+    out, report = tmp_path / "bunny.ply", tmp_path / "report"
+    assert main(["demo", "-o", str(out), "--report", str(report), "--resolution", "40"]) == 0
     text = capsys.readouterr().out
     assert "boundary loops kept; edges per loop:" in text and str(out) in text
+    assert f"report: {report / 'report.html'}" in text
+    assert "| screened Poisson + density trim |" in text and "chamfer" in text  # the bunny's mesh is the truth
     ms = pymeshlab.MeshSet()
     ms.load_new_mesh(str(out))
     assert ms.current_mesh().face_number() > 10000
+    assert (report / "side_by_side.png").is_file()
+
+
+@pytest.fixture
+def sphere_files(tmp_path):
+    """A point cloud (PLY with normals) and its true mesh (OFF) of a sphere with two holes."""
+    points, faces = two_holed_sphere(1500)
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=points, v_normals_matrix=points))
+    ms.save_current_mesh(str(tmp_path / "cloud.ply"))
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=points, face_matrix=faces))
+    ms.save_current_mesh(str(tmp_path / "truth.off"))
+    return tmp_path / "cloud.ply", tmp_path / "truth.off"
+
+
+def test_compare_writes_the_report_and_prints_the_table(sphere_files, tmp_path, capsys, plugin):
+    cloud, truth = sphere_files
+    report = tmp_path / "out" / "report"
+    assert main(["compare", str(cloud), "--truth", str(truth), "--report", str(report), "--resolution", "24",
+                 "--trim-quantile", "0.1"]) == 0
+    captured = capsys.readouterr()
+    lines = {line.split("|")[1].strip(): line for line in captured.out.splitlines() if line.startswith("| ")}
+    assert {"ours", "screened Poisson", "screened Poisson + density trim"} <= set(lines)
+    assert "| 2/2 |" in lines["ours"]
+    assert f"report: {report / 'report.html'}" in captured.out
+    assert "0.1" in (report / "report.html").read_text()  # the trim quantile used
+    assert "8/8 done" in captured.err  # the progress bar
+
+
+def test_compare_bad_arguments_exit_2_with_usage(capsys):
+    with pytest.raises(SystemExit) as exit:
+        main(["compare", "cloud.ply"])  # no --report
+    assert exit.value.code == 2 and "--report" in capsys.readouterr().err
+    with pytest.raises(SystemExit) as exit:
+        main(["compare", "cloud.ply", "--report", "r", "--trim-quantile", "lots"])
+    assert exit.value.code == 2
+
+
+def test_compare_refuses_a_bad_quantile_in_one_line(sphere_files, tmp_path, capsys):
+    cloud, _ = sphere_files
+    assert main(["compare", str(cloud), "--report", str(tmp_path / "r"), "--trim-quantile", "1.5"]) == 1
+    assert "quantile" in one_error_line(capsys)
+
+
+@pytest.mark.parametrize("command", ["compare", "reconstruct"])
+def test_unreadable_input_is_one_line_and_status_1(command, tmp_path, capsys):
+    bad = tmp_path / "garbage.ply"
+    bad.write_text("not a mesh\n")
+    extra = ["--report", str(tmp_path / "r")] if command == "compare" else ["-o", str(tmp_path / "x.ply")]
+    assert main([command, str(bad), *extra]) == 1
+    assert "garbage.ply" in one_error_line(capsys)
+
+
+def test_unreadable_truth_is_one_line_and_status_1(sphere_files, tmp_path, capsys, plugin):
+    cloud, _ = sphere_files
+    bad = tmp_path / "truth.obj"
+    bad.write_text("v 0 0 0\n")  # a vertex, no faces
+    assert main(["compare", str(cloud), "--truth", str(bad), "--report", str(tmp_path / "r")]) == 1
+    assert "no faces" in one_error_line(capsys)
+    assert main(["compare", str(cloud), "--truth", str(tmp_path / "none.ply"), "--report", str(tmp_path / "r")]) == 1
+    assert "no such file" in one_error_line(capsys)
+
+
+def test_verbose_shows_the_exception(tmp_path):
+    with pytest.raises(FileNotFoundError):
+        main(["--verbose", "compare", str(tmp_path / "nope.ply"), "--report", str(tmp_path / "r")])
+
+
+@pytest.mark.parametrize("source, target", [("xyz", "stl"), ("ply", "off"), ("off", "obj")])
+def test_reconstruct_converts_between_formats(source, target, tmp_path, capsys, plugin):
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(str(DEMO_SCAN))
+    src = tmp_path / f"cloud.{source}"
+    ms.save_current_mesh(str(src))
+    out = tmp_path / f"surface.{target}"
+    assert main(["reconstruct", str(src), "-o", str(out), "--resolution", "32"]) == 0
+    ms.load_new_mesh(str(out))
+    assert ms.current_mesh().face_number() > 1000
+
+
+def test_unknown_output_format_is_one_line(tmp_path, capsys, plugin):
+    assert main(["reconstruct", str(DEMO_SCAN), "-o", str(tmp_path / "x.nope"), "--resolution", "32"]) == 1
+    assert "nope" in one_error_line(capsys)
 
 
 def test_reconstruct_reads_and_writes_files(tmp_path, capsys, plugin):
@@ -27,8 +120,9 @@ def test_reconstruct_reads_and_writes_files(tmp_path, capsys, plugin):
 
 def test_missing_input_is_one_line_and_status_1(tmp_path, capsys):
     assert main(["reconstruct", str(tmp_path / "nope.ply"), "-o", str(tmp_path / "x.ply")]) == 1
-    err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "no such file" in err[0]
+    assert "no such file" in one_error_line(capsys)
+    assert main(["compare", str(tmp_path / "nope.ply"), "--report", str(tmp_path / "r")]) == 1
+    assert "no such file" in one_error_line(capsys)
 
 
 def test_bad_parameter_is_reported_not_raised(tmp_path, capsys, plugin):
@@ -43,9 +137,10 @@ def test_info_reports_the_plugin(capsys, plugin):
 
 def test_options_reach_the_filter(tmp_path, capsys, plugin):
     keep_all = tmp_path / "all.ply"
-    assert main(["demo", "-o", str(keep_all), "--min-boundary-edges", "0", "--boundary-smoothing", "0"]) == 0
+    assert main(["reconstruct", str(DEMO_SCAN), "-o", str(keep_all), "--min-boundary-edges", "0",
+                 "--boundary-smoothing", "0"]) == 0
     unfilled = capsys.readouterr().out
-    assert main(["demo", "-o", str(tmp_path / "default.ply")]) == 0
+    assert main(["reconstruct", str(DEMO_SCAN), "-o", str(tmp_path / "default.ply")]) == 0
     filled = capsys.readouterr().out
     count = lambda text: int(text.split(" boundary loops kept")[0].split()[-1])
     assert count(unfilled) > count(filled)

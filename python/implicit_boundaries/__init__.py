@@ -5,9 +5,12 @@
     ms = pymeshlab.MeshSet(); ms.load_new_mesh("scan.ply")
     out = ms.generate_surface_reconstruction_implicit_with_boundaries(resolution=128)
 
-or, with numpy arrays only, :func:`reconstruct`.
+or, with numpy arrays only, :func:`reconstruct`; side by side with MeshLab's screened Poisson
+(table, pictures, report), :func:`compare`.
 """
 from ._plugin import FILTER_NAME, apply, load, plugin_path
+from .compare import Comparison, compare
 from .reconstruct import Reconstruction, loops_from_result, reconstruct
 
-__all__ = ["FILTER_NAME", "apply", "load", "plugin_path", "reconstruct", "Reconstruction", "loops_from_result"]
+__all__ = ["FILTER_NAME", "apply", "load", "plugin_path", "reconstruct", "Reconstruction", "loops_from_result",
+           "compare", "Comparison"]

@@ -1,8 +1,10 @@
 """Command line: ``implicit-boundaries`` (or ``python -m implicit_boundaries``).
 
-Subcommands: ``reconstruct IN -o OUT`` (any format pymeshlab reads and writes), ``demo``
-(pymeshlab's bunny scan with its holes) and ``info`` (versions, plugin path, whether it loads).
-Errors are one line on stderr and exit status 1; ``--verbose`` shows the traceback.
+Subcommands: ``reconstruct IN -o OUT`` (any format pymeshlab reads and writes), ``compare IN
+[--truth GT] --report DIR`` (side by side with MeshLab's screened Poisson), ``demo``
+(pymeshlab's bunny scan with its holes, reconstructed and compared) and ``info`` (versions,
+plugin path, whether it loads). Errors are one line on stderr and exit status 1; ``--verbose``
+shows the traceback.
 """
 import argparse
 import sys
@@ -13,6 +15,7 @@ import numpy as np
 import pymeshlab
 
 from ._plugin import FILTER_NAME, apply, load
+from .compare import compare
 from .reconstruct import loops_from_result
 
 DEMO_SCAN = Path(pymeshlab.__file__).parent / "tests" / "sample_meshes" / "bunny10k_textured.obj"
@@ -28,14 +31,49 @@ def _point_cloud(ms: pymeshlab.MeshSet, path: Path) -> None:
     ms.add_mesh(points, path.stem)
 
 
-def _reconstruct(ms: pymeshlab.MeshSet, args) -> dict:
-    load()
+class ProgressBar:
+    """A text progress bar on stderr: redrawn in place on a terminal, a line per step elsewhere."""
+
+    def __init__(self, stream=None, width: int = 30):
+        self.stream, self.width, self.open = stream or sys.stderr, width, False
+
+    def __call__(self, done: int, total: int, what: str) -> None:
+        filled = self.width * done // max(total, 1)
+        line = f"[{'#' * filled}{'.' * (self.width - filled)}] {done}/{total} {what}"
+        if self.stream.isatty():
+            self.stream.write(f"\r{line:<{self.width + 50}}")
+            self.open = done < total
+            if not self.open:
+                self.stream.write("\n")
+        else:
+            self.stream.write(line + "\n")
+        self.stream.flush()
+
+    def close(self) -> None:
+        """Ends a line left open (before an error message)."""
+        if self.open:
+            self.stream.write("\n")
+            self.open = False
+
+
+def _filter_params(args) -> dict:
+    """Our filter's parameters given on the command line (others keep their defaults)."""
     params = {name: getattr(args, name)
-              for name in ("resolution", "sods_dilation", "sample_radius", "min_boundary_edges", "boundary_smoothing")
+              for name in ("sods_dilation", "sample_radius", "min_boundary_edges", "boundary_smoothing")
               if getattr(args, name) is not None}
     if args.paper_occupancy:
         params["sods_occupancy"] = "Sample cells (paper)"
-    return apply(ms, normals="Estimate" if args.estimate_normals else "Use layer normals", **params)
+    if args.estimate_normals:
+        params["normals"] = "Estimate"
+    return params
+
+
+def _reconstruct(ms: pymeshlab.MeshSet, args) -> dict:
+    load()
+    params = _filter_params(args)
+    if args.resolution is not None:
+        params["resolution"] = args.resolution
+    return apply(ms, **params)
 
 
 def _report(result: dict, out: Path) -> None:
@@ -61,15 +99,37 @@ def cmd_reconstruct(args) -> int:
     return 0
 
 
+def _compare(args, input, truth) -> int:
+    bar = ProgressBar()
+    args.progress = bar  # main() closes it before an error message
+    table = compare(input, truth, resolution=args.resolution or 0, depth=args.depth, trim_quantile=args.trim_quantile,
+                    poisson_threads=args.poisson_threads, params=_filter_params(args), report=args.report,
+                    progress=bar)
+    print(table.table())
+    print(f"report: {table.report.resolve()}")
+    return 0
+
+
+def cmd_compare(args) -> int:
+    return _compare(args, Path(args.input), None if args.truth is None else Path(args.truth))
+
+
 def cmd_demo(args) -> int:
     print(f"input: vertices and normals of {DEMO_SCAN} (pymeshlab's Stanford bunny, 5 holes at its base)")
     args.input = DEMO_SCAN
-    return cmd_reconstruct(args)
+    cmd_reconstruct(args)
+    print("comparing with MeshLab's screened Poisson, the scan's own mesh as ground truth")
+    return _compare(args, DEMO_SCAN, DEMO_SCAN)
 
 
 def cmd_info(args) -> int:
     print(f"pymeshlab {metadata.version('pymeshlab')} (plugin built for 2025.7.post1)")
     print(f"numpy {np.__version__}")
+    for name in ("pyvista", "vtk", "matplotlib"):  # needed for the pictures of a comparison report
+        try:
+            print(f"{name} {metadata.version(name)}")
+        except metadata.PackageNotFoundError:
+            print(f"{name}: not installed (compare --report needs it)")
     try:
         path = load()
     except (FileNotFoundError, pymeshlab.PyMeshLabException) as e:  # diagnose, don't crash
@@ -101,8 +161,24 @@ def _parser() -> argparse.ArgumentParser:
     options(r)
     r.set_defaults(run=cmd_reconstruct)
 
-    d = sub.add_parser("demo", help="reconstruct pymeshlab's bunny scan with its holes")
+    def comparison(q, report):
+        q.add_argument("--report", required=report is None, default=report,
+                       help="folder for report.html, its pictures and each method's mesh")
+        q.add_argument("--depth", type=int, help="screened Poisson depth (default: 2^depth nearest our resolution)")
+        q.add_argument("--trim-quantile", type=float, default=0.05,
+                       help="Poisson vertices below this density quantile are removed (default 0.05)")
+        q.add_argument("--poisson-threads", type=int, default=1, help="screened Poisson threads (default 1)")
+
+    c = sub.add_parser("compare", help="side by side with MeshLab's screened Poisson: table, pictures, report")
+    c.add_argument("input")
+    c.add_argument("--truth", help="ground-truth mesh: adds chamfer, spurious/missing area, boundary distance")
+    comparison(c, None)
+    options(c)
+    c.set_defaults(run=cmd_compare)
+
+    d = sub.add_parser("demo", help="reconstruct pymeshlab's bunny scan with its holes and compare")
     d.add_argument("-o", "--output", default="out/bunny_with_boundaries.ply")
+    comparison(d, "out/bunny_report")
     options(d)
     d.set_defaults(run=cmd_demo)
 
@@ -116,7 +192,11 @@ def main(argv=None) -> int:
     try:
         return args.run(args)
     except (pymeshlab.PyMeshLabException, OSError, ValueError) as e:
+        if getattr(args, "progress", None):
+            args.progress.close()
         if args.verbose:
             raise
-        print(f"implicit-boundaries: error: {e}", file=sys.stderr)
+        # pymeshlab's messages span lines; the error stays one line.
+        message = "; ".join(line.strip() for line in str(e).splitlines() if line.strip())
+        print(f"implicit-boundaries: error: {message}", file=sys.stderr)
         return 1

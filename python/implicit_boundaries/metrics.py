@@ -1,5 +1,5 @@
 """Measures on meshes with boundaries, for tests, benchmarks and comparisons."""
-from typing import Dict, List, Sequence
+from typing import Dict, List, Sequence, Tuple
 
 import numpy as np
 import scipy.sparse as sp
@@ -12,12 +12,7 @@ def boundary_vertex_sets(faces: np.ndarray, n_vertices: int) -> List[np.ndarray]
 
     faces: (f, 3) vertex indices. Returns one sorted index array per component.
     """
-    faces = np.asarray(faces, dtype=np.int64)
-    if len(faces) == 0:
-        return []
-    edges = np.sort(np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]), axis=1)
-    unique, counts = np.unique(edges, axis=0, return_counts=True)
-    border = unique[counts == 1]
+    border = boundary_edges(faces)
     if len(border) == 0:
         return []
     graph = sp.coo_matrix((np.ones(len(border)), (border[:, 0], border[:, 1])), shape=(n_vertices, n_vertices))
@@ -42,3 +37,120 @@ def match_loops(true_points: Sequence[np.ndarray], loops: Sequence[np.ndarray], 
         if d.mean() < tolerance:
             found.setdefault(int(owner[nearest[np.argmin(d)]]), []).append(i)
     return found
+
+
+def boundary_edges(faces: np.ndarray) -> np.ndarray:
+    """(b, 2) vertex index pairs (smaller first) of the edges used by exactly one of the (f, 3) faces."""
+    faces = np.asarray(faces, dtype=np.int64).reshape(-1, 3)
+    edges = np.sort(np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]), axis=1)
+    unique, counts = np.unique(edges, axis=0, return_counts=True)
+    return unique[counts == 1]
+
+
+def boundary_distance(truth: Sequence[np.ndarray], loops: Sequence[np.ndarray]) -> float:
+    """Symmetric mean distance between the true boundary points and the found loop points
+    (DESIGN.md section 5): each a list of (k, 3) point arrays. 0 when neither side has a
+    boundary, nan when only one has."""
+    if not len(truth) or not len(loops):
+        return float("nan") if len(truth) or len(loops) else 0.0
+    t, o = np.concatenate(truth), np.concatenate(loops)
+    return 0.5 * (cKDTree(o).query(t)[0].mean() + cKDTree(t).query(o)[0].mean())
+
+
+def loops_found(truth: Sequence[np.ndarray], loops: Sequence[np.ndarray], tolerance: float,
+                min_edges: int = 10) -> Tuple[int, List[int]]:
+    """How many true boundaries are found, and the sizes of the spurious loops.
+
+    truth, loops: lists of (k, 3) point arrays. A loop belongs to the true boundary it lies
+    on (:func:`match_loops` with `tolerance`); a true boundary counts as found when its largest
+    loop has at least `min_edges` points. Returns (found, sizes of the loops on no boundary).
+    """
+    matched = match_loops(truth, loops, tolerance)
+    found = sum(max(len(loops[i]) for i in ids) >= min_edges for ids in matched.values())
+    assigned = {i for ids in matched.values() for i in ids}
+    return found, [len(loop) for i, loop in enumerate(loops) if i not in assigned]
+
+
+def triangle_areas(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """(f,) areas of the (f, 3) faces over the (m, 3) vertices."""
+    v = np.asarray(vertices, dtype=np.float64)[np.asarray(faces, dtype=np.int64)]
+    return 0.5 * np.linalg.norm(np.cross(v[:, 1] - v[:, 0], v[:, 2] - v[:, 0]), axis=1)
+
+
+def sample_surface(vertices: np.ndarray, faces: np.ndarray, count: int, seed: int = 0) -> np.ndarray:
+    """(count, 3) points drawn uniformly by area on the triangle mesh (same seed, same points)."""
+    rng = np.random.default_rng(seed)
+    areas = triangle_areas(vertices, faces)
+    face = rng.choice(len(areas), size=count, p=areas / areas.sum())
+    r1, r2 = rng.random(count), rng.random(count)
+    # Square-root warp: uniform density over each triangle.
+    s = np.sqrt(r1)
+    a, b, c = (np.asarray(vertices, dtype=np.float64)[np.asarray(faces)[face, k]] for k in range(3))
+    return (1 - s)[:, None] * a + (s * (1 - r2))[:, None] * b + (s * r2)[:, None] * c
+
+
+def _segment_distance(p, a, b):
+    ab = b - a
+    t = np.clip(np.einsum("...i,...i", p - a, ab) / np.maximum(np.einsum("...i,...i", ab, ab), 1e-300), 0, 1)
+    return np.linalg.norm(p - (a + t[..., None] * ab), axis=-1)
+
+
+def point_triangle_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """Distances from points p to triangles (a, b, c), all arrays (..., 3) broadcast together."""
+    v0, v1, v2 = b - a, c - a, p - a
+    d00, d01, d11 = (np.einsum("...i,...i", x, y) for x, y in [(v0, v0), (v0, v1), (v1, v1)])
+    d20, d21 = np.einsum("...i,...i", v2, v0), np.einsum("...i,...i", v2, v1)
+    denom = d00 * d11 - d01 * d01
+    ok = denom > 1e-300  # degenerate triangles are measured by their edges only
+    safe = np.where(ok, denom, 1.0)
+    v, w = (d11 * d20 - d01 * d21) / safe, (d00 * d21 - d01 * d20) / safe
+    inside = ok & (v >= 0) & (w >= 0) & (v + w <= 1)
+    normal = np.cross(v0, v1)
+    plane = np.abs(np.einsum("...i,...i", v2, normal)) / np.sqrt(np.where(ok, np.einsum("...i,...i", normal, normal), 1.0))
+    edges = np.minimum(np.minimum(_segment_distance(p, a, b), _segment_distance(p, b, c)), _segment_distance(p, c, a))
+    return np.where(inside, plane, edges)
+
+
+def point_mesh_distance(points: np.ndarray, vertices: np.ndarray, faces: np.ndarray,
+                        candidates: int = 16, chunk: int = 20000) -> np.ndarray:
+    """(n,) distance from each of the (n, 3) points to the triangle mesh.
+
+    Exact point-to-triangle distances to the `candidates` triangles with the nearest
+    centroids: exact wherever the nearest triangle is among them, which holds on meshes of
+    even-sized triangles (scans, marching cubes output); an overestimate elsewhere.
+    """
+    vertices = np.asarray(vertices, dtype=np.float64)
+    faces = np.asarray(faces, dtype=np.int64).reshape(-1, 3)
+    tri = vertices[faces]
+    k = min(candidates, len(faces))
+    tree = cKDTree(tri.mean(axis=1))
+    out = np.empty(len(points))
+    for start in range(0, len(points), chunk):
+        p = np.asarray(points[start:start + chunk], dtype=np.float64)
+        _, near = tree.query(p, k=k)
+        near = near.reshape(len(p), k)
+        t = tri[near]
+        d = point_triangle_distance(p[:, None, :], t[..., 0, :], t[..., 1, :], t[..., 2, :])
+        out[start:start + chunk] = d.min(axis=1)
+    return out
+
+
+def surface_distances(vertices, faces, truth_vertices, truth_faces, tolerance: float,
+                      samples: int = 20000) -> Dict[str, float]:
+    """Distances between a result mesh and a true mesh (DESIGN.md section 5), in the units of
+    the vertices, from `samples` area-uniform points on each:
+
+    chamfer: the mean of the two mean sample-to-other-mesh distances; spurious: fraction of
+    the result's area farther than `tolerance` from the truth; missing: fraction of the
+    truth's area farther than `tolerance` from the result. A result without faces misses
+    everything (chamfer nan).
+    """
+    truth_points = sample_surface(truth_vertices, truth_faces, samples, seed=1)
+    if len(faces) == 0:
+        return {"chamfer": float("nan"), "spurious": 0.0, "missing": 1.0}
+    points = sample_surface(vertices, faces, samples, seed=2)
+    to_truth = point_mesh_distance(points, truth_vertices, truth_faces)
+    to_result = point_mesh_distance(truth_points, vertices, faces)
+    return {"chamfer": 0.5 * (to_truth.mean() + to_result.mean()),
+            "spurious": float(np.mean(to_truth > tolerance)),
+            "missing": float(np.mean(to_result > tolerance))}
