@@ -9,7 +9,6 @@
 
 #include <algorithm>
 #include <map>
-#include <unordered_map>
 #include <vector>
 
 namespace ib {
@@ -27,34 +26,27 @@ class BoundaryLoops
 {
 public:
     /// Loops of the faces f of `mesh` with surface[f] != 0 (every face when `surface` is empty),
-    /// largest first by edge count. A loop that touches itself or another loop at a vertex is
-    /// one component and is traced as one closed walk (Hierholzer), so every boundary edge is
-    /// in exactly one loop.
+    /// largest first by edge count. Needs the mesh's face-face adjacency (vcg::tri::
+    /// UpdateTopology::FaceFace): an edge is a boundary when the face across it is itself (the
+    /// mesh's border) or not in the surface. A loop that touches itself or another loop at a
+    /// vertex is one component and is traced as one closed walk (Hierholzer), so every
+    /// boundary edge is in exactly one loop.
     static std::vector<BoundaryLoop> Compute(const CoreMesh& mesh, const std::vector<char>& surface = {})
     {
         auto inSurface = [&](size_t f) { return surface.empty() || surface[f]; };
-        auto key = [](uint64_t a, uint64_t b) { return a << 32 | b; };
-        // Directed half-edges a->b of every face, with the face that owns them.
-        std::unordered_map<uint64_t, int> owner;
-        owner.reserve(mesh.face.size() * 3);
-        for (size_t f = 0; f < mesh.face.size(); ++f)
-            for (int i = 0; i < 3; ++i)
-                owner.emplace(key(vcg::tri::Index(mesh, mesh.face[f].cV(i)), vcg::tri::Index(mesh, mesh.face[f].cV((i + 1) % 3))),
-                              int(f));
-
         // Outgoing boundary edges per vertex (target, face across), sorted for a deterministic walk.
         std::map<int, std::vector<std::pair<int, int>>> out;
         for (size_t f = 0; f < mesh.face.size(); ++f) {
             if (!inSurface(f))
                 continue;
+            const CoreFace& face = mesh.face[f];
             for (int i = 0; i < 3; ++i) {
-                const int a = int(vcg::tri::Index(mesh, mesh.face[f].cV(i)));
-                const int b = int(vcg::tri::Index(mesh, mesh.face[f].cV((i + 1) % 3)));
-                auto opposite = owner.find(key(uint64_t(b), uint64_t(a)));
-                if (opposite == owner.end())
-                    out[a].emplace_back(b, -1);
-                else if (!inSurface(size_t(opposite->second)))
-                    out[a].emplace_back(b, opposite->second);
+                const size_t across = vcg::tri::Index(mesh, face.cFFp(i));
+                if (across != f && inSurface(across))
+                    continue;
+                const int a = int(vcg::tri::Index(mesh, face.cV(i)));
+                const int b = int(vcg::tri::Index(mesh, face.cV((i + 1) % 3)));
+                out[a].emplace_back(b, across == f ? -1 : int(across));
             }
         }
         for (auto& [v, targets] : out)

@@ -181,29 +181,35 @@ private:
             }
         }
 
-        /// Evaluates the corners of `cells` that have no value yet (one batch call).
+        /// Evaluates the corners of `cells` that have no value yet, a block of cells per batch
+        /// call (so the keys and query points of a large run are never all in memory at once).
         void Evaluate(const std::vector<Index3>& cells)
         {
             if (!dense_.empty())
                 return;
+            constexpr size_t kBlock = 1 << 16;
             std::vector<uint64_t> keys;
-            keys.reserve(cells.size() * 8);
-            for (const Index3& c : cells)
-                for (uint64_t k : CornerKeys(c))
-                    if (!values_.count(k))
-                        keys.push_back(k);
-            std::sort(keys.begin(), keys.end());
-            keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
-            Points Q(keys.size(), 3);
-            for (size_t i = 0; i < keys.size(); ++i) {
-                const Index3 v = UnpackIndex(keys[i]);
-                Q.row(Eigen::Index(i)) = lattice_.Corner(v[0], v[1], v[2]).transpose();
+            Points Q;
+            Eigen::VectorXd out;
+            for (size_t begin = 0; begin < cells.size(); begin += kBlock) {
+                keys.clear();
+                for (size_t i = begin; i < std::min(cells.size(), begin + kBlock); ++i)
+                    for (uint64_t k : CornerKeys(cells[i]))
+                        if (!values_.count(k))
+                            keys.push_back(k);
+                std::sort(keys.begin(), keys.end());
+                keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+                Q.resize(Eigen::Index(keys.size()), 3);
+                for (size_t i = 0; i < keys.size(); ++i) {
+                    const Index3 v = UnpackIndex(keys[i]);
+                    Q.row(Eigen::Index(i)) = lattice_.Corner(v[0], v[1], v[2]).transpose();
+                }
+                out.resize(Q.rows());
+                f_.Eval(Q, out);
+                values_.reserve(values_.size() + keys.size());
+                for (size_t i = 0; i < keys.size(); ++i)
+                    values_.emplace(keys[i], out[Eigen::Index(i)]);
             }
-            Eigen::VectorXd out(Q.rows());
-            f_.Eval(Q, out);
-            values_.reserve(values_.size() + keys.size());
-            for (size_t i = 0; i < keys.size(); ++i)
-                values_.emplace(keys[i], out[Eigen::Index(i)]);
         }
 
         double operator()(uint64_t key) const
@@ -247,16 +253,36 @@ private:
         /// Corners evaluated so far.
         size_t Count() const { return dense_.empty() ? values_.size() : dense_.size(); }
 
-        /// Distinct corners of `cells` (only of the crossed ones when `crossed`).
+        /// Distinct corners of `cells` (only of the crossed ones when `crossed`). Counted one
+        /// corner level z at a time, from the cells at z - 1 and z, to keep the keys small.
         size_t CornerCount(const std::vector<Index3>& cells, bool crossed) const
         {
-            std::vector<uint64_t> keys;
+            std::vector<uint64_t> cellKeys;
+            std::vector<int> levels;
             for (const Index3& c : cells)
-                if (!crossed || Crossed(c))
-                    for (uint64_t k : CornerKeys(c))
-                        keys.push_back(k);
-            std::sort(keys.begin(), keys.end());
-            return size_t(std::unique(keys.begin(), keys.end()) - keys.begin());
+                if (!crossed || Crossed(c)) {
+                    cellKeys.push_back(PackIndex(c[0], c[1], c[2]));
+                    levels.push_back(c[2]);
+                    levels.push_back(c[2] + 1);
+                }
+            std::sort(cellKeys.begin(), cellKeys.end());  // z first
+            std::sort(levels.begin(), levels.end());
+            levels.erase(std::unique(levels.begin(), levels.end()), levels.end());
+            size_t count = 0;
+            std::vector<uint64_t> level;
+            for (int z : levels) {
+                level.clear();
+                auto first = std::lower_bound(cellKeys.begin(), cellKeys.end(), PackIndex(0, 0, std::max(0, z - 1)));
+                auto last = std::lower_bound(cellKeys.begin(), cellKeys.end(), PackIndex(0, 0, z + 1));
+                for (auto it = first; it != last; ++it) {
+                    const Index3 c = UnpackIndex(*it);
+                    for (int k = 0; k < 4; ++k)
+                        level.push_back(PackIndex(c[0] + (k & 1), c[1] + (k >> 1), z));
+                }
+                std::sort(level.begin(), level.end());
+                count += size_t(std::unique(level.begin(), level.end()) - level.begin());
+            }
+            return count;
         }
 
     private:

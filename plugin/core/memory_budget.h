@@ -11,10 +11,10 @@ namespace ib {
 struct MemoryBudget
 {
     /// Peak bytes per SODS cell of a SODS-driven run: corner values and welded edge vertices
-    /// (hash maps), the extracted vertices and faces with adjacency, the split copies and the
-    /// host's copy of the result. Measured (peak RSS over SODS cells) on bun_zipper and a
-    /// synthetic 1M-sample scan; rounded up.
-    static constexpr double kBytesPerSodsCell = 600;
+    /// (hash maps), the extracted vertices and faces with adjacency, and the host's copy of
+    /// the result. Measured: 325 (peak RSS growth over SODS cells, bench/extraction.py's
+    /// synthetic 1M-sample scan at resolution 1024 through pymeshlab); rounded up.
+    static constexpr double kBytesPerSodsCell = 400;
 
     /// Half the physical memory: room for the host application and its other layers.
     static double Default()

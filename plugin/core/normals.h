@@ -5,13 +5,26 @@
 /// the neighbour graph, or towards a viewpoint when one is given).
 
 #include "lattice.h"
-#include "mesh.h"
 
+#include <vcg/complex/complex.h>
 #include <vcg/complex/algorithms/pointcloud_normal.h>
 
 #include <optional>
 
 namespace ib {
+
+class PointVertex;
+struct PointUsedTypes : public vcg::UsedTypes<vcg::Use<PointVertex>::AsVertexType>
+{
+};
+/// What VCG's normal estimation works on: positions, normals, flags and marks.
+class PointVertex : public vcg::Vertex<PointUsedTypes, vcg::vertex::Coord3d, vcg::vertex::Normal3d,
+                                       vcg::vertex::BitFlags, vcg::vertex::Mark>
+{
+};
+class PointCloud : public vcg::tri::TriMesh<std::vector<PointVertex>>
+{
+};
 
 class PointNormals
 {
@@ -29,12 +42,12 @@ public:
     /// Returns whether that global flip was applied through `flipped`.
     static Points Compute(const Points& P, const Param& p, bool* flipped = nullptr)
     {
-        CoreMesh m;
-        auto vi = vcg::tri::Allocator<CoreMesh>::AddVertices(m, size_t(P.rows()));
+        PointCloud m;
+        auto vi = vcg::tri::Allocator<PointCloud>::AddVertices(m, size_t(P.rows()));
         for (Eigen::Index i = 0; i < P.rows(); ++i, ++vi)
             vi->P() = vcg::Point3d(P(i, 0), P(i, 1), P(i, 2));
 
-        vcg::tri::PointCloudNormal<CoreMesh>::Param vp;
+        vcg::tri::PointCloudNormal<PointCloud>::Param vp;
         vp.fittingAdjNum = p.neighbours;
         vp.coherentAdjNum = p.neighbours;
         vp.smoothingIterNum = p.smoothing_iterations;
@@ -42,7 +55,7 @@ public:
             vp.useViewPoint = true;
             vp.viewPoint = vcg::Point3d((*p.viewpoint)[0], (*p.viewpoint)[1], (*p.viewpoint)[2]);
         }
-        vcg::tri::PointCloudNormal<CoreMesh>::Compute(m, vp, nullptr);
+        vcg::tri::PointCloudNormal<PointCloud>::Compute(m, vp, nullptr);
 
         Points N(P.rows(), 3);
         for (Eigen::Index i = 0; i < P.rows(); ++i) {

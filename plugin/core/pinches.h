@@ -18,19 +18,38 @@ class Pinches
 public:
     /// Among the faces f of `mesh` with inSurface[f], removes (sets to 0) the smaller fans at
     /// every pinch vertex, repeating while removals create new pinches (at most `passes`).
-    /// Returns the number of faces removed.
+    /// Returns the number of faces removed. Needs the mesh's face-face adjacency.
     static size_t Resolve(const CoreMesh& mesh, std::vector<char>& inSurface, int passes = 8)
     {
-        std::vector<std::vector<int>> around(mesh.vert.size());
-        for (size_t f = 0; f < mesh.face.size(); ++f)
-            for (int i = 0; i < 3; ++i)
-                around[vcg::tri::Index(mesh, mesh.face[f].cV(i))].push_back(int(f));
-
         size_t removed = 0;
         for (int pass = 0; pass < passes; ++pass) {
+            // Only a vertex on the surface's boundary can join two fans: the surface and the
+            // hole faces together are an edge-manifold, so elsewhere one fan goes all around.
+            std::vector<int> slot(mesh.vert.size(), -1);
+            int candidates = 0;
+            for (size_t f = 0; f < mesh.face.size(); ++f)
+                for (int i = 0; inSurface[f] && i < 3; ++i) {
+                    const size_t across = vcg::tri::Index(mesh, mesh.face[f].cFFp(i));
+                    if (across == f || !inSurface[across])
+                        for (int k : {i, (i + 1) % 3}) {
+                            int& s = slot[vcg::tri::Index(mesh, mesh.face[f].cV(k))];
+                            if (s < 0)
+                                s = candidates++;
+                        }
+                }
+            std::vector<std::vector<int>> around(static_cast<size_t>(candidates));
+            std::vector<int> vertexOf(static_cast<size_t>(candidates));
+            for (size_t f = 0; f < mesh.face.size(); ++f)
+                for (int i = 0; i < 3; ++i) {
+                    const size_t v = vcg::tri::Index(mesh, mesh.face[f].cV(i));
+                    if (slot[v] >= 0) {
+                        around[size_t(slot[v])].push_back(int(f));
+                        vertexOf[size_t(slot[v])] = int(v);
+                    }
+                }
             size_t now = 0;
-            for (size_t v = 0; v < around.size(); ++v)
-                now += RemoveSmallerFans(mesh, int(v), around[v], inSurface);
+            for (size_t c = 0; c < around.size(); ++c)
+                now += RemoveSmallerFans(mesh, vertexOf[c], around[c], inSurface);
             removed += now;
             if (now == 0)
                 break;

@@ -23,6 +23,9 @@
 #include <Eigen/Eigenvalues>
 
 #include <chrono>
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
 #include <iomanip>
 #include <numeric>
 #include <cmath>
@@ -195,6 +198,7 @@ public:
         r.hole_cells = mc.hole_cells;
         r.hole_search_capped = mc.hole_search_capped;
         r.seconds_extraction = seconds(t);
+        ReleaseFreedMemory();  // the corner and edge hash maps, before the boundary stage grows
 
         t = Clock::now();
         if (cb) cb(97, "Tracing boundary loops, filling small holes");
@@ -203,6 +207,7 @@ public:
             Split(surface, inSurface, 0, *holes);
         KeepSurface(surface, inSurface);
         r.loops = BoundaryLoops::Compute(surface);
+        ReleaseFreedMemory();  // before the host copies the surface
         r.seconds_boundaries = seconds(t);
         return r;
     }
@@ -229,6 +234,7 @@ public:
     {
         std::vector<char> inSurface(all.face.size(), 0);
         std::fill(inSurface.begin(), inSurface.begin() + long(mc.surface_faces), 1);
+        UpdateFaceFace(all);  // once, for every boundary step
         if (p.extraction == GatedMarchingCubes::Extraction::Plain)
             return inSurface;  // the closed reference: nothing to fill, trim or smooth
         const std::vector<int> fill = SmallHoles(all, inSurface, mc, p.min_boundary_edges, r.loops_before_filling);
@@ -236,7 +242,6 @@ public:
             if (fill[size_t(mc.face_region[face - mc.surface_faces])])
                 inSurface[face] = 1;
         r.holes_filled = int(std::count(fill.begin(), fill.end(), 1));
-        vcg::tri::UpdateTopology<CoreMesh>::FaceFace(all);  // once, for the trim and the scraps
         if (p.boundary_trim > 0)
             r.faces_trimmed = BoundaryTrim::Compute(all, samples, p.boundary_trim * spacing, inSurface, p.threads);
         r.faces_unpinched = Pinches::Resolve(all, inSurface);
@@ -273,10 +278,29 @@ public:
         return fill;
     }
 
+    /// Hands memory freed by the last stage back to the system. Millions of small hash map
+    /// nodes, once freed, stay in the allocator's heap and count towards the process's peak
+    /// when the next stage (or the host's copy of the result) allocates large blocks.
+    static void ReleaseFreedMemory()
+    {
+#ifdef __GLIBC__
+        malloc_trim(0);
+#endif
+    }
+
     /// Deletes the faces f of `mesh` with !inSurface[f] and the vertices they alone used;
-    /// compacts, keeping the order of what remains.
+    /// compacts, keeping the order of what remains and a valid face-face adjacency (edges
+    /// towards deleted faces become border edges).
     static void KeepSurface(CoreMesh& mesh, const std::vector<char>& inSurface)
     {
+        for (size_t face = 0; face < mesh.face.size(); ++face) {
+            CoreFace& f = mesh.face[face];
+            for (int i = 0; inSurface[face] && i < 3; ++i)
+                if (!inSurface[vcg::tri::Index(mesh, f.FFp(i))]) {
+                    f.FFp(i) = &f;
+                    f.FFi(i) = i;
+                }
+        }
         for (size_t face = 0; face < mesh.face.size(); ++face)
             if (!inSurface[face])
                 vcg::tri::Allocator<CoreMesh>::DeleteFace(mesh, mesh.face[face]);

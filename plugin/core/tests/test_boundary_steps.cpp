@@ -80,6 +80,8 @@ TEST(BoundarySteps, PinchKeepsTheLargerFan)
     AddTriangle(m, o, vcg::Point3d(0, 1, 0), vcg::Point3d(-0.2, 1, 0));
     AddTriangle(m, o, vcg::Point3d(-1, -1, 0), vcg::Point3d(0, -1, 0));
     vcg::tri::Clean<CoreMesh>::RemoveDuplicateVertex(m);
+    vcg::tri::Allocator<CoreMesh>::CompactEveryVector(m);
+    vcg::tri::UpdateTopology<CoreMesh>::FaceFace(m);
     std::vector<char> inSurface(4, 1);
     EXPECT_EQ(Pinches::Resolve(m, inSurface), 1u);
     EXPECT_EQ(inSurface, (std::vector<char>{1, 1, 1, 0}));
