@@ -13,24 +13,30 @@
 /// local fit sees at least `min_samples` samples (or all of them, if there are fewer).
 ///
 /// Local function: f_c(x) = h [ sum_j l_j |u - u_j|^3 + a_0 + a.u ],  u = (x - centre)/h,
-/// with h the support box's half side and centres u_j at the samples in the box. It is the
-/// least-squares fit to the constraints f = 0 at the samples and f = +-e at the off-surface
-/// points p +- e n moved along the normals to both sides, with a ridge term:
-///     min |M c - v|^2 + mu |c|^2,   c = (l, a),   mu = `regularization` * trace(M^T M) / |c|.
+/// with h the support box's half side and the centres u_j up to `max_centres` of the samples in
+/// the box, spread by farthest-point sampling. It is the least-squares fit to the constraints
+/// f = 0 at every sample in the box and f = +-e at the off-surface points p +- e n moved along
+/// the normals to both sides of each centre, with a ridge term:
+///     min |M c - v|^2 + mu |l|^2 (+ 1e-6 mu |a|^2),   mu = `regularization` * mean diag(M^T M).
 /// Why this kernel and this system:
 /// - r^3 (triharmonic) with a linear polynomial is the smoothest (C^2, minimal energy) radial
 ///   spline in 3D without a scale parameter, so no kernel width has to be tuned per cell; the
-///   linear part reproduces planes exactly, so a flat patch gives its signed distance.
-/// - Centres only at the samples (not at the off-surface points) with least squares over the
-///   three constraints per sample: a third of the unknowns of the interpolating system, so
-///   fitting is ~10x and evaluation 3x cheaper, and the fit may smooth noise instead of
-///   interpolating it.
+///   linear part reproduces planes, so a flat patch gives its signed distance.
+/// - Fewer centres than constraints (least squares instead of interpolation): a box holds ~3x
+///   its cell's samples, and interpolating all of them and their off-surface points would mean
+///   ~800 unknowns per cell (O(n^3) to solve, ~8 s for 35k samples) and ~800 kernel terms per
+///   evaluation. With 80 centres the fit costs ~100x less, an evaluation ~10x less, and the
+///   accuracy on smooth data is the same (the surface does not vary at the sample scale); on
+///   noisy data least squares averages the noise instead of interpolating it.
 /// - The ridge term makes the normal matrix positive definite whatever the input: duplicate
 ///   samples (identical columns), nearly coplanar or collinear samples (rank-deficient
 ///   polynomial block) all give a unique, bounded solution. The coordinates are normalised to
 ///   the support box, so the ridge is scale-free. Solved by Cholesky (LLT); if that fails or
-///   gives non-finite values, by column-pivoting QR; if that too fails, the cell keeps only the
-///   least-squares plane.
+///   gives non-finite values, the cell keeps only its least-squares plane.
+/// - The moment conditions sum l_j = 0, sum l_j u_j = 0 of the interpolating RBF system are
+///   kept (as constraints on the least squares): without them the r^3 terms grow like |u|^3
+///   off the data and the far corners of a support box change sign, which shows as spurious
+///   sheets away from the samples.
 ///
 /// Off-surface distance: e_i = `off_surface` times the local sample spacing at sample i
 /// (spacing.h; clamped to [0.5, 2] times the median spacing so isolated samples and piles of
@@ -80,7 +86,7 @@ public:
     {
         int min_samples = 50;          ///< fewest samples a local fit sees (support grown until)
         int max_samples = 160;         ///< a cell holding more is split
-        double overlap = 1.5;          ///< support box side / cell side (advanced)
+        double overlap = 1.5;          ///< support box side / cell side (advanced): a quarter cell each side
         double off_surface = 1.0;      ///< off-surface distance e, in local sample spacings (advanced)
         double regularization = 1e-8;  ///< ridge, relative to the mean diagonal of M^T M (advanced)
         int max_fit_samples = 400;     ///< cap of the samples in one local fit (piles of duplicates)
@@ -433,7 +439,7 @@ private:
     }
 
     /// Least-squares fit of one cell (see the file comment); returns whether it fell back from
-    /// Cholesky.
+    /// Cholesky to the plane.
     bool FitCell(Cell& c, const std::vector<int>& ids, Buffers& buf)
     {
         ChooseCentres(c, ids, buf);
@@ -474,18 +480,26 @@ private:
         G.diagonal().head(k).array() += mu;
         G.diagonal().tail<4>().array() += 1e-6 * mu;
 
-        Eigen::VectorXd sol = G.selfadjointView<Eigen::Lower>().llt().solve(b);
-        bool fell_back = false;
-        if (!sol.allFinite() || !((G.selfadjointView<Eigen::Lower>() * sol - b).norm() <= 1e-6 * b.norm() + 1e-300)) {
-            fell_back = true;
-            const Eigen::MatrixXd full = G.selfadjointView<Eigen::Lower>();
-            sol = full.colPivHouseholderQr().solve(b);
-            if (!sol.allFinite()) {  // keep the least-squares plane only
-                sol.setZero(cols);
-                const Eigen::MatrixXd Pt = Mt.bottomRows<4>().transpose();
-                const Eigen::Vector4d a = Pt.colPivHouseholderQr().solve(v);
-                sol.tail<4>() = a.allFinite() ? a : Eigen::Vector4d::Zero();
-            }
+        // Subject to the moment conditions sum l_j = 0, sum l_j u_j = 0 (C sol = 0), by the
+        // Schur complement of G (a 4x4 system). Without them the r^3 terms grow like |u|^3 away
+        // from the centres and the far corners of a box can change sign: spurious sheets.
+        const Eigen::LLT<Eigen::MatrixXd, Eigen::Lower> llt(G);
+        Eigen::Matrix<double, 4, Eigen::Dynamic> C = Eigen::MatrixXd::Zero(4, cols);
+        C.row(0).head(k).setOnes();
+        C.row(1).head(k) = X.matrix().transpose();
+        C.row(2).head(k) = Y.matrix().transpose();
+        C.row(3).head(k) = Z.matrix().transpose();
+        const Eigen::Matrix<double, Eigen::Dynamic, 4> W = llt.solve(C.transpose());
+        Eigen::Matrix4d S = C * W;  // singular when the centres are coplanar: a small ridge
+        S.diagonal().array() += 1e-12 * S.trace() + std::numeric_limits<double>::min();
+        Eigen::VectorXd sol = llt.solve(b);
+        sol -= W * S.ldlt().solve(C * sol);
+        const bool fell_back = llt.info() != Eigen::Success || !sol.allFinite();
+        if (fell_back) {  // keep the least-squares plane only
+            sol.setZero(cols);
+            const Eigen::MatrixXd Pt = Mt.bottomRows<4>().transpose();
+            const Eigen::Vector4d a = Pt.colPivHouseholderQr().solve(v);
+            sol.tail<4>() = a.allFinite() ? a : Eigen::Vector4d::Zero();
         }
         lambda_.segment(c.begin, k) = sol.head(k).array();
         c.poly = sol.tail<4>();
