@@ -8,8 +8,9 @@
 ///
 /// Cells: an octree over the bounding cube of the samples, a cell split while it holds more
 /// than `max_samples` samples. Every leaf holding a sample gets a local function on its support
-/// box: the leaf cube scaled by `overlap` about its centre, grown further (to the distance of
-/// the `min_samples`-th nearest sample from the centre) where the data are sparse, so every
+/// box: a cube centred on the centroid of the leaf's samples, `overlap` times the leaf's side
+/// (more if needed to keep the leaf's samples a margin inside), grown further (to the distance
+/// of the `min_samples`-th nearest sample from its centre) where the data are sparse, so every
 /// local fit sees at least `min_samples` samples (or all of them, if there are fewer).
 ///
 /// Local function: f_c(x) = h [ sum_j l_j |u - u_j|^3 + a_0 + a.u ],  u = (x - centre)/h,
@@ -88,9 +89,10 @@ public:
         int max_samples = 160;         ///< a cell holding more is split
         double overlap = 1.5;          ///< support box side / cell side (advanced): a quarter cell each side
         double off_surface = 1.0;      ///< off-surface distance e, in local sample spacings (advanced)
-        double regularization = 1e-8;  ///< ridge, relative to the mean diagonal of M^T M (advanced)
+        double regularization = 1e-6;  ///< ridge, relative to the mean diagonal of M^T M (advanced)
         int max_fit_samples = 400;     ///< cap of the samples in one local fit (piles of duplicates)
-        int max_centres = 80;          ///< RBF centres per local function (advanced)
+        int max_centres = 80;          ///< RBF centres per local function: a third on samples, the rest
+                                       ///< their off-surface points (advanced)
         int threads = 0;               ///< 0 = all cores
     };
 
@@ -245,9 +247,20 @@ private:
                 ++stats_.leaves;
                 if (nd.end > nd.begin) {
                     nd.cell = int(cells_.size());
+                    // The support box is centred on the centroid of the leaf's samples, where
+                    // the local fit is best: the weight peaks there, not in a corner of the
+                    // leaf with no data. It keeps the leaf's samples `overlap - 1` leaf
+                    // half-sides inside its border, and is at least the leaf scaled by `overlap`.
                     Cell c;
-                    c.centre = nd.centre;
-                    c.half = nd.half;  // support chosen in Fit
+                    c.centre.setZero();
+                    for (int k = nd.begin; k < nd.end; ++k)
+                        c.centre += P_.row(order_[size_t(k)]).transpose();
+                    c.centre /= nd.end - nd.begin;
+                    double spread = 0;
+                    for (int k = nd.begin; k < nd.end; ++k)
+                        spread = std::max(spread, (P_.row(order_[size_t(k)]).transpose() - c.centre).cwiseAbs().maxCoeff());
+                    const double overlap = std::max(1.0, param_.overlap);
+                    c.half = std::max(overlap * nd.half, spread + (overlap - 1) * nd.half);
                     cells_.push_back(c);
                 }
             }
@@ -322,24 +335,23 @@ private:
     void Fit(vcg::CallBackPos* cb)
     {
         const int ncells = int(cells_.size());
-        std::vector<std::vector<int>> local(static_cast<size_t>(ncells));
+        std::vector<std::vector<int>> local(static_cast<size_t>(ncells)), chosen(static_cast<size_t>(ncells));
         const int k = std::min<int>(std::max(1, param_.min_samples), int(P_.rows()));
         const size_t cap = size_t(std::max(param_.max_fit_samples, std::max(1, param_.min_samples)));
         ParallelFor(size_t(ncells), param_.threads, [&](size_t begin, size_t end, int) {
             std::vector<int> stack;
+            std::vector<double> far;
             SampleIndex::Queue queue;
             for (size_t ci = begin; ci < end; ++ci) {
                 Cell& c = cells_[ci];
                 std::vector<int>& ids = local[ci];
-                const double own = c.half;
-                c.half = std::max(1.0, param_.overlap) * own;
                 Gather(c.centre.array() - c.half, c.centre.array() + c.half, ids, stack);
                 if (int(ids.size()) < k) {  // sparse: grow the box to the k-th nearest sample
                     index_.Nearest(c.centre, k, queue);
                     c.half = std::max(c.half, std::sqrt(queue.getTopWeight()) * (1 + 1e-9));
                     Gather(c.centre.array() - c.half, c.centre.array() + c.half, ids, stack);
                 }
-                if (ids.size() > cap) {  // keep the nearest (L-inf) to the centre, shrink the box to them
+                if (ids.size() > cap) {  // keep the nearest (L-inf) to the centre
                     auto linf = [&](int s) { return (P_.row(s).transpose() - c.centre).cwiseAbs().maxCoeff(); };
                     std::nth_element(ids.begin(), ids.begin() + Eigen::Index(cap) - 1, ids.end(), [&](int a, int b) {
                         const double da = linf(a), db = linf(b);
@@ -347,23 +359,22 @@ private:
                     });
                     ids.resize(cap);
                     std::sort(ids.begin(), ids.end());
-                    c.half = own;
-                    for (int s : ids)
-                        c.half = std::max(c.half, linf(s));
                 }
                 c.inv_half = 1 / c.half;
+                ChooseCentres(c, ids, chosen[ci], far);
             }
         }, 16);
 
         // Centres laid out cell after cell.
-        const int most = std::max(1, param_.max_centres);
         size_t total = 0, rows = 0, cols = 0;
-        for (int ci = 0; ci < ncells; ++ci) {
-            const size_t m = local[size_t(ci)].size(), centres = std::min(m, size_t(most));
-            cells_[size_t(ci)].begin = int(total);
+        for (size_t ci = 0; ci < size_t(ncells); ++ci) {
+            size_t centres = 0;
+            for (int s : chosen[ci])
+                centres += 1 + (eps_(s, 0) != 0) + (eps_(s, 1) != 0);
+            cells_[ci].begin = int(total);
             total += centres;
-            cells_[size_t(ci)].end = int(total);
-            rows = std::max(rows, m + 2 * centres);
+            cells_[ci].end = int(total);
+            rows = std::max(rows, local[ci].size() + centres - chosen[ci].size());
             cols = std::max(cols, centres + 4);
         }
         stats_.centres = total;
@@ -382,7 +393,7 @@ private:
             buf.G.resize(Eigen::Index(cols), Eigen::Index(cols));
             buf.v.resize(Eigen::Index(rows));
             for (size_t ci = begin; ci < end; ++ci) {
-                fallback[ci] = FitCell(cells_[ci], local[ci], buf);
+                fallback[ci] = FitCell(cells_[ci], local[ci], chosen[ci], buf);
                 const int d = ++done;
                 // Only the calling thread reports, so the callback needs no locking and is monotone.
                 if (cb && thread == 0) {
@@ -400,56 +411,63 @@ private:
     {
         Eigen::MatrixXd Mt, G;   ///< transposed design matrix (a column per constraint), normal matrix
         Eigen::VectorXd v;       ///< constraint values
-        std::vector<double> far; ///< farthest-point sampling: squared distance to the chosen centres
-        std::vector<int> centre; ///< positions in ids of the chosen centres
     };
 
-    /// Up to max_centres of the cell's samples, spread by farthest-point sampling from the one
-    /// nearest the cell centre (ties: the first), into buf.centre.
-    void ChooseCentres(const Cell& c, const std::vector<int>& ids, Buffers& buf) const
+    /// Up to max_centres/3 of the cell's samples ids, spread by farthest-point sampling from the
+    /// one nearest the cell centre (ties: the first), into `out` (sample ids, ascending).
+    /// far: reused buffer.
+    void ChooseCentres(const Cell& c, const std::vector<int>& ids, std::vector<int>& out, std::vector<double>& far) const
     {
-        const int m = int(ids.size()), count = std::min(m, std::max(1, param_.max_centres));
-        buf.centre.clear();
+        const int m = int(ids.size()), count = std::min(m, std::max(1, (param_.max_centres + 2) / 3));
+        out.clear();
         if (count == m) {
-            for (int j = 0; j < m; ++j)
-                buf.centre.push_back(j);
+            out = ids;
+            std::sort(out.begin(), out.end());
             return;
         }
-        buf.far.resize(size_t(m));
+        far.resize(size_t(m));
         int next = 0;
         for (int j = 0; j < m; ++j) {
-            buf.far[size_t(j)] = (P_.row(ids[size_t(j)]).transpose() - c.centre).squaredNorm();
-            if (buf.far[size_t(j)] < buf.far[size_t(next)])
+            far[size_t(j)] = (P_.row(ids[size_t(j)]).transpose() - c.centre).squaredNorm();
+            if (far[size_t(j)] < far[size_t(next)])
                 next = j;
         }
-        std::fill(buf.far.begin(), buf.far.end(), std::numeric_limits<double>::infinity());
-        while (int(buf.centre.size()) < count) {
-            buf.centre.push_back(next);
+        std::fill(far.begin(), far.end(), std::numeric_limits<double>::infinity());
+        while (int(out.size()) < count) {
+            out.push_back(ids[size_t(next)]);
             const auto p = P_.row(ids[size_t(next)]);
             int farthest = 0;
             for (int j = 0; j < m; ++j) {
-                double& d = buf.far[size_t(j)];
+                double& d = far[size_t(j)];
                 d = std::min(d, (P_.row(ids[size_t(j)]) - p).squaredNorm());
-                if (d > buf.far[size_t(farthest)])
+                if (d > far[size_t(farthest)])
                     farthest = j;
             }
             next = farthest;
         }
-        std::sort(buf.centre.begin(), buf.centre.end());
+        std::sort(out.begin(), out.end());
     }
 
-    /// Least-squares fit of one cell (see the file comment); returns whether it fell back from
+    /// Least-squares fit of one cell (see the file comment) to its samples ids, with centres at
+    /// the chosen samples and their off-surface points; returns whether it fell back from
     /// Cholesky to the plane.
-    bool FitCell(Cell& c, const std::vector<int>& ids, Buffers& buf)
+    bool FitCell(Cell& c, const std::vector<int>& ids, const std::vector<int>& chosen, Buffers& buf)
     {
-        ChooseCentres(c, ids, buf);
-        const int m = int(ids.size()), k = int(buf.centre.size()), cols = k + 4;
-        for (int j = 0; j < k; ++j) {
-            const Eigen::Vector3d u = (P_.row(ids[size_t(buf.centre[size_t(j)])]).transpose() - c.centre) * c.inv_half;
-            cx_[c.begin + j] = u[0];
-            cy_[c.begin + j] = u[1];
-            cz_[c.begin + j] = u[2];
+        int k = 0;
+        auto centre = [&](const Eigen::Vector3d& u) {
+            cx_[c.begin + k] = u[0];
+            cy_[c.begin + k] = u[1];
+            cz_[c.begin + k] = u[2];
+            ++k;
+        };
+        for (int s : chosen) {
+            const Eigen::Vector3d u = (P_.row(s).transpose() - c.centre) * c.inv_half, n = N_.row(s).transpose();
+            centre(u);
+            for (int side = 0; side < 2; ++side)
+                if (const double e = eps_(s, side) * c.inv_half)
+                    centre(u + e * n);
         }
+        const int cols = k + 4;
         const auto X = cx_.segment(c.begin, k), Y = cy_.segment(c.begin, k), Z = cz_.segment(c.begin, k);
         int rows = 0;
         auto constraint = [&](const Eigen::Vector3d& u, double value) {
@@ -458,15 +476,17 @@ private:
             buf.Mt.col(rows).segment<4>(k) << 1, u[0], u[1], u[2];
             buf.v[rows++] = value;
         };
-        // Zero at every sample in the box; +-e off the surface at the centres.
+        // Zero at every sample in the box; +-e at the off-surface centres.
         for (int s : ids)
             constraint((P_.row(s).transpose() - c.centre) * c.inv_half, 0);
-        for (int j = 0; j < k; ++j) {
-            const int s = ids[size_t(buf.centre[size_t(j)])];
-            const Eigen::Vector3d u(X[j], Y[j], Z[j]), n = N_.row(s).transpose();
+        int j = 0;
+        for (int s : chosen) {
+            ++j;  // the sample itself: its zero is among the rows above
             for (int side = 0; side < 2; ++side)
-                if (const double e = eps_(s, side) * c.inv_half)
-                    constraint(u + e * n, e);
+                if (const double e = eps_(s, side) * c.inv_half) {
+                    constraint(Eigen::Vector3d(X[j], Y[j], Z[j]), e);
+                    ++j;
+                }
         }
         const auto Mt = buf.Mt.topLeftCorner(cols, rows);
         const auto v = buf.v.head(rows);
