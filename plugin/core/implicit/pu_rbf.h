@@ -14,36 +14,42 @@
 /// local fit sees at least `min_samples` samples (or all of them, if there are fewer).
 ///
 /// Local function: f_c(x) = h [ sum_j l_j |u - u_j|^3 + a_0 + a.u ],  u = (x - centre)/h,
-/// with h the support box's half side and the centres u_j up to `max_centres` of the samples in
-/// the box, spread by farthest-point sampling. It is the least-squares fit to the constraints
-/// f = 0 at every sample in the box and f = +-e at the off-surface points p +- e n moved along
-/// the normals to both sides of each centre, with a ridge term:
-///     min |M c - v|^2 + mu |l|^2 (+ 1e-6 mu |a|^2),   mu = `regularization` * mean diag(M^T M).
+/// with h the support box's half side. Centres u_j: about max_centres/3 of the samples in the
+/// box, spread by farthest-point sampling, and their two off-surface points p +- e n (moved
+/// along the normal to both sides). It is the least-squares fit to the constraints f = 0 at
+/// every sample in the box and f = +-e at those off-surface points, with a ridge term,
+///     min |M c - v|^2 + mu |l|^2 (+ 1e-6 mu |a|^2),   mu = `regularization` * mean diag(M^T M),
+/// subject to the moment conditions sum l_j = 0, sum l_j u_j = 0 (Schur complement, 4x4).
 /// Why this kernel and this system:
 /// - r^3 (triharmonic) with a linear polynomial is the smoothest (C^2, minimal energy) radial
 ///   spline in 3D without a scale parameter, so no kernel width has to be tuned per cell; the
 ///   linear part reproduces planes, so a flat patch gives its signed distance.
 /// - Fewer centres than constraints (least squares instead of interpolation): a box holds ~3x
 ///   its cell's samples, and interpolating all of them and their off-surface points would mean
-///   ~800 unknowns per cell (O(n^3) to solve, ~8 s for 35k samples) and ~800 kernel terms per
-///   evaluation. With 80 centres the fit costs ~100x less, an evaluation ~10x less, and the
-///   accuracy on smooth data is the same (the surface does not vary at the sample scale); on
-///   noisy data least squares averages the noise instead of interpolating it.
+///   ~800 unknowns per cell (O(n^3): seconds for 35k samples) and ~800 kernel terms per
+///   evaluation. With 80 centres the fit costs ~100x less and an evaluation ~10x less; on
+///   smooth data the zero set stays within a few thousandths of a spacing (the surface does not
+///   vary at the sample scale), and on noisy data least squares averages the noise instead of
+///   interpolating it. Centres at off-surface points too, as in Carr et al. 2001: with centres
+///   on the surface only, the field across it was ~5x less accurate.
+/// - The moment conditions of the interpolating RBF system are kept: without them the r^3 terms
+///   grow like |u|^3 off the data and the far corners of a support box change sign, which
+///   showed as spurious sheets away from the samples.
 /// - The ridge term makes the normal matrix positive definite whatever the input: duplicate
 ///   samples (identical columns), nearly coplanar or collinear samples (rank-deficient
 ///   polynomial block) all give a unique, bounded solution. The coordinates are normalised to
-///   the support box, so the ridge is scale-free. Solved by Cholesky (LLT); if that fails or
-///   gives non-finite values, the cell keeps only its least-squares plane.
-/// - The moment conditions sum l_j = 0, sum l_j u_j = 0 of the interpolating RBF system are
-///   kept (as constraints on the least squares): without them the r^3 terms grow like |u|^3
-///   off the data and the far corners of a support box change sign, which shows as spurious
-///   sheets away from the samples.
+///   the support box, so the ridge is scale-free. The default 1e-6 also damps the noise: on
+///   0.5%-diagonal noise 1e-8 left small bubbles inside a torus, and costs ~0.001 spacing of
+///   accuracy on clean data. Solved by Cholesky (LLT); if that fails or gives non-finite
+///   values, the cell keeps only its least-squares plane.
 ///
-/// Off-surface distance: e_i = `off_surface` times the local sample spacing at sample i
+/// Off-surface distance: e_i = `off_surface` (default 1) times the local sample spacing at sample i
 /// (spacing.h; clamped to [0.5, 2] times the median spacing so isolated samples and piles of
 /// duplicates get a sane value). The spacing, not the cell size, sets e because it is what
 /// bounds the scale of detail the samples resolve, and it does not change when min/max_samples
-/// do. The standard check (Carr et al. 2001): an off-surface point closer to another sample
+/// do. One spacing: at 0.5 the clean fit is more accurate, but 0.5%-diagonal noise (~0.4
+/// spacing) then swamps the +-e constraints and signs flip 3 spacings off a noisy torus; at 2
+/// the clean fit is ~10x less accurate and more points are dropped at thin parts. The standard check (Carr et al. 2001): an off-surface point closer to another sample
 /// than to its own would cross a thin part or a fold; e is halved up to twice, then the point
 /// is dropped.
 ///
