@@ -38,20 +38,20 @@
 /// - The ridge term makes the normal matrix positive definite whatever the input: duplicate
 ///   samples (identical columns), nearly coplanar or collinear samples (rank-deficient
 ///   polynomial block) all give a unique, bounded solution. The coordinates are normalised to
-///   the support box, so the ridge is scale-free. The default 1e-6 also damps the noise: on
-///   0.5%-diagonal noise 1e-8 left small bubbles inside a torus, and costs ~0.001 spacing of
-///   accuracy on clean data. Solved by Cholesky (LLT); if that fails or gives non-finite
+///   the support box, so the ridge is scale-free. The default 1e-6 also damps noise: on a torus
+///   with 0.5%-diagonal noise, the extracted zero set strays up to 1.2 lattice cells from the
+///   true torus with 1e-8 and 0.33 with 1e-6 (tests), for ~0.001 spacing lost on clean data. Solved by Cholesky (LLT); if that fails or gives non-finite
 ///   values, the cell keeps only its least-squares plane.
 ///
-/// Off-surface distance: e_i = `off_surface` (default 1) times the local sample spacing at sample i
-/// (spacing.h; clamped to [0.5, 2] times the median spacing so isolated samples and piles of
-/// duplicates get a sane value). The spacing, not the cell size, sets e because it is what
-/// bounds the scale of detail the samples resolve, and it does not change when min/max_samples
-/// do. One spacing: at 0.5 the clean fit is more accurate, but 0.5%-diagonal noise (~0.4
-/// spacing) then swamps the +-e constraints and signs flip 3 spacings off a noisy torus; at 2
-/// the clean fit is ~10x less accurate and more points are dropped at thin parts. The standard check (Carr et al. 2001): an off-surface point closer to another sample
-/// than to its own would cross a thin part or a fold; e is halved up to twice, then the point
-/// is dropped.
+/// Off-surface distance: e_i = `off_surface` (default 1) times the local sample spacing at
+/// sample i (spacing.h; clamped to [0.5, 2] times the median spacing so isolated samples and
+/// piles of duplicates get a sane value). The spacing, not the cell size, sets e because it is
+/// the scale of detail the samples resolve, and it does not change with min/max_samples. On the
+/// tests' sphere and torus, clean or noisy, 0.5 to 2 spacings give the same accuracy within
+/// ~25%; one spacing stays above scan noise (a fraction of a spacing) while keeping the points
+/// on the right side of thin parts. The standard check (Carr et al. 2001): an off-surface point
+/// closer to another sample than to its own would cross a thin part or a fold; e is halved up
+/// to twice, then the point is dropped.
 ///
 /// Blending: F(x) = sum_c w_c(x) f_c(x) / sum_c w_c(x), with the tensor-product bump
 /// w_c(x) = prod_axis (1 - u_a^2)^2 on the support box (C^1, exactly zero outside the box, so a
@@ -107,7 +107,7 @@ public:
         int octree_nodes = 0, leaves = 0, cells = 0;  ///< cells: leaves with a local function
         size_t centres = 0;                            ///< RBF centres over all cells
         size_t off_surface_points = 0, off_surface_dropped = 0;
-        int solver_fallbacks = 0;                      ///< cells solved by QR or reduced to a plane
+        int solver_fallbacks = 0;                      ///< cells whose solve failed: reduced to their plane
         double median_spacing = 0, fit_seconds = 0;
     };
 
@@ -118,10 +118,15 @@ public:
 
     /// P, N: n×3 samples and unit outward normals (rows). Both are copied. Fits all local
     /// functions; cb (may be null) goes from 0 to 100. Throws std::invalid_argument for no
-    /// samples, mismatched shapes, non-finite positions, or samples that all coincide.
+    /// samples, mismatched shapes, non-finite positions, samples that all coincide, or
+    /// parameters out of range.
     PuRbf(const Points& P, const Points& N, const Param& param, vcg::CallBackPos* cb = nullptr)
         : P_(Check(P, N)), N_(Normalised(N)), index_(P_), param_(param)
     {
+        if (!(param.min_samples >= 1 && param.max_samples >= 1 && param.overlap >= 1 && param.off_surface > 0 &&
+              param.max_fit_samples >= 1 && param.max_centres >= 1))
+            throw std::invalid_argument("PuRbf: min_samples, max_samples, max_fit_samples and max_centres must be "
+                                        ">= 1, overlap >= 1 and off_surface > 0");
         const auto start = std::chrono::steady_clock::now();
         auto progress = [&](int percent, const char* what) { if (cb) cb(percent, what); };
         progress(0, "PU-RBF: octree");
@@ -265,7 +270,7 @@ private:
                     double spread = 0;
                     for (int k = nd.begin; k < nd.end; ++k)
                         spread = std::max(spread, (P_.row(order_[size_t(k)]).transpose() - c.centre).cwiseAbs().maxCoeff());
-                    const double overlap = std::max(1.0, param_.overlap);
+                    const double overlap = param_.overlap;
                     c.half = std::max(overlap * nd.half, spread + (overlap - 1) * nd.half);
                     cells_.push_back(c);
                 }
@@ -342,8 +347,8 @@ private:
     {
         const int ncells = int(cells_.size());
         std::vector<std::vector<int>> local(static_cast<size_t>(ncells)), chosen(static_cast<size_t>(ncells));
-        const int k = std::min<int>(std::max(1, param_.min_samples), int(P_.rows()));
-        const size_t cap = size_t(std::max(param_.max_fit_samples, std::max(1, param_.min_samples)));
+        const int k = std::min<int>(param_.min_samples, int(P_.rows()));
+        const size_t cap = size_t(std::max(param_.max_fit_samples, param_.min_samples));
         ParallelFor(size_t(ncells), param_.threads, [&](size_t begin, size_t end, int) {
             std::vector<int> stack;
             std::vector<double> far;
@@ -424,7 +429,7 @@ private:
     /// far: reused buffer.
     void ChooseCentres(const Cell& c, const std::vector<int>& ids, std::vector<int>& out, std::vector<double>& far) const
     {
-        const int m = int(ids.size()), count = std::min(m, std::max(1, (param_.max_centres + 2) / 3));
+        const int m = int(ids.size()), count = std::min(m, (param_.max_centres + 2) / 3);
         out.clear();
         if (count == m) {
             out = ids;

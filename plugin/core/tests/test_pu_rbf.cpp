@@ -374,6 +374,9 @@ TEST(PuRbf, RejectsImpossibleInput)
     EXPECT_THROW(PuRbf(P, N.topRows(50)), std::invalid_argument);
     Points same = Points::Ones(30, 3);
     EXPECT_THROW(PuRbf(same, N.topRows(30)), std::invalid_argument);
+    PuRbf::Param bad;
+    bad.overlap = 0.5;
+    EXPECT_THROW(PuRbf(P, N, bad), std::invalid_argument);
     P(3, 1) = std::nan("");
     EXPECT_THROW(PuRbf(P, N), std::invalid_argument);
 }
