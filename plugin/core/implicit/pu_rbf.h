@@ -149,9 +149,8 @@ public:
     void Eval(const Points& Q, Eigen::Ref<Eigen::VectorXd> values) const override
     {
         ParallelFor(size_t(Q.rows()), param_.threads, [&](size_t begin, size_t end, int) {
-            SampleIndex::Queue queue;
             for (size_t i = begin; i < end; ++i)
-                values[Eigen::Index(i)] = EvalOne(Q.row(Eigen::Index(i)).transpose(), queue);
+                values[Eigen::Index(i)] = EvalOne(Q.row(Eigen::Index(i)).transpose());
         });
     }
 
@@ -557,7 +556,39 @@ private:
         }
     }
 
-    double EvalOne(const Eigen::Vector3d& q, SampleIndex::Queue& queue) const
+    /// The sample nearest to q, by branch and bound over the octree with a fixed stack (VCG's
+    /// k-d tree query allocates its stack on every call).
+    int NearestSample(const Eigen::Vector3d& q) const
+    {
+        std::array<int, 7 * kMaxDepth + 8> stack;
+        int top = 0, best = -1;
+        double best_d2 = std::numeric_limits<double>::infinity();
+        stack[size_t(top++)] = 0;
+        while (top > 0) {
+            const Node& nd = nodes_[size_t(stack[size_t(--top)])];
+            const Eigen::Array3d gap = ((q - nd.centre).array().abs() - nd.half).max(0.0);
+            if (nd.end == nd.begin || gap.square().sum() >= best_d2)
+                continue;
+            if (nd.child >= 0) {
+                // q's own octant last, so it is searched first and prunes the others.
+                const int own = int(q[0] >= nd.centre[0]) | int(q[1] >= nd.centre[1]) << 1 | int(q[2] >= nd.centre[2]) << 2;
+                for (int o = 7; o >= 0; --o)
+                    stack[size_t(top++)] = nd.child + (o ^ own);
+                continue;
+            }
+            for (int k = nd.begin; k < nd.end; ++k) {
+                const int s = order_[size_t(k)];
+                const double d2 = (P_.row(s).transpose() - q).squaredNorm();
+                if (d2 < best_d2) {
+                    best_d2 = d2;
+                    best = s;
+                }
+            }
+        }
+        return best;
+    }
+
+    double EvalOne(const Eigen::Vector3d& q) const
     {
         // Depth-first over the boxes containing q; children in a fixed order, so the sum is
         // the same whichever thread evaluates q. A fixed stack: no allocation per query.
@@ -590,8 +621,7 @@ private:
         }
         if (weights >= kCoverage)
             return sum / weights;
-        index_.Nearest(q, 1, queue);
-        const int s = queue.getIndex(0);
+        const int s = NearestSample(q);
         const double plane = (q - P_.row(s).transpose()).dot(N_.row(s).transpose());
         return (sum + (kCoverage - weights) * plane) / kCoverage;
     }
