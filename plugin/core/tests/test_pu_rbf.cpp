@@ -435,7 +435,7 @@ TEST(PuRbf, MarchingCubesExtractsTheSphere)
     }
     std::printf("[ PU-RBF   ] marching cubes on the sphere: vertex distance max %.4f mean %.4f cells\n",
                 worst / l.cell_size, sum / m.vn / l.cell_size);
-    EXPECT_LT(worst, 0.1 * l.cell_size);
+    EXPECT_LT(worst, 0.1 * l.cell_size);  // measured: max 0.014, mean 0.0025 cells
     const auto t = test::Check(m);
     EXPECT_EQ(t.border_edges, 0);
     EXPECT_EQ(t.non_manifold_edges, 0);
@@ -470,6 +470,7 @@ TEST(PuRbf, MarchingCubesExtractsTheNoisyTorusWithoutSpuriousSheets)
     std::printf("[ PU-RBF   ] marching cubes on the noisy torus: vertex distance to the torus max %.3f mean %.3f cells, "
                 "to the nearest sample max %.3f cells\n",
                 worst / l.cell_size, sum / m.vn / l.cell_size, farthest / l.cell_size);
+    // Measured: max 0.33, mean 0.062 cells from the torus; at most 0.82 cells from a sample.
     EXPECT_LT(sum / m.vn, 0.15 * l.cell_size);
     EXPECT_LT(worst, 0.75 * l.cell_size);
     EXPECT_LT(farthest, 2 * l.cell_size);
@@ -513,7 +514,7 @@ TEST(PuRbf, SpeedReport)
         const double heval = seconds(t0);
         const auto& s = f.Statistics();
         std::printf("[ PU-RBF   ] %ld samples, %d thread(s): PU-RBF fit %.3f s (%d cells, %.0f centres/cell, %zu of %zu "
-                    "off-surface points dropped), eval %.3f us/query; Hoppe index %.3f s, eval %.3f us/query (%ld queries)\n",
+                    "off-surface points dropped), eval %.3f us/query (wall); Hoppe index %.3f s, eval %.3f us/query (%ld queries)\n",
                     long(P.rows()), threads, fit, s.cells, double(s.centres) / s.cells, s.off_surface_dropped,
                     s.off_surface_points + s.off_surface_dropped, 1e6 * eval / Q.rows(), hfit, 1e6 * heval / Q.rows(),
                     long(Q.rows()));
