@@ -11,6 +11,8 @@ namespace {
 const QStringList kNormalSources = {"Use layer normals", "Estimate"};
 // Order matches ib::Reconstruction::Occupancy.
 const QStringList kOccupancies = {"Tangent disks", "Sample cells (paper)"};
+// Order matches ib::Reconstruction::Implicit.
+const QStringList kImplicits = {"PU-RBF (paper)", "Hoppe signed distance"};
 // Order matches ib::GatedMarchingCubes::Extraction.
 const QStringList kExtractions = {"SODS-driven", "Full lattice, gated", "Plain marching cubes"};
 
@@ -130,6 +132,32 @@ RichParameterList FilterImplicitBoundariesPlugin::reconstructionParameters(const
 			.arg(ib::Reconstruction::kMinResolution)
 			.arg(ib::Reconstruction::kMaxResolution)));
 	par.addParam(RichEnum(
+		"implicit", int(d.implicit), kImplicits, "Implicit function",
+		"The implicit surface that is extracted. 'PU-RBF (paper)': local radial basis functions "
+		"fitted to the samples and their normals in overlapping octree cells, blended by a "
+		"partition of unity (Tobor et al. 2006): smooth and close to the samples. 'Hoppe signed "
+		"distance': blended distance to the nearest samples' tangent planes (Hoppe et al. 1992): "
+		"no fitting, follows noise more closely."));
+	par.addParam(RichInt(
+		"rbf_min_samples", d.rbf.min_samples, "PU-RBF: min samples per cell",
+		"Each local RBF sees at least this many samples (its support grows where the scan is "
+		"sparse). Raise it for noisy scans (smoother), lower it for fine detail.",
+		true));
+	par.addParam(RichInt(
+		"rbf_max_samples", d.rbf.max_samples, "PU-RBF: max samples per cell",
+		"Octree cells holding more samples are split. Larger cells fit slower but smoother.",
+		true));
+	par.addParam(RichFloat(
+		"rbf_overlap", d.rbf.overlap, "PU-RBF: overlap",
+		"Support box side over cell side: how far neighbouring local functions overlap and "
+		"blend. 1 = no overlap (seams); raise it if the surface shows ridges between cells.",
+		true));
+	par.addParam(RichFloat(
+		"rbf_off_surface", d.rbf.off_surface, "PU-RBF: off-surface distance (spacings)",
+		"Distance along the normals of the off-surface constraints (+e outside, -e inside), in "
+		"local sample spacings. Lower it for thin parts whose sides are closer than two spacings.",
+		true));
+	par.addParam(RichEnum(
 		"sods_occupancy", int(d.occupancy), kOccupancies, "SODS occupancy",
 		"Which lattice cells the samples mark in the spatial occupancy data structure (SODS); "
 		"the surface is only extracted in marked cells. 'Tangent disks': each sample marks the "
@@ -230,6 +258,11 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 	p.occupancy = ib::Reconstruction::Occupancy(par.getEnum("sods_occupancy"));
 	p.sample_radius = par.getFloat("sample_radius");
 	p.extraction = ib::GatedMarchingCubes::Extraction(par.getEnum("extraction"));
+	p.implicit = ib::Reconstruction::Implicit(par.getEnum("implicit"));
+	p.rbf.min_samples = par.getInt("rbf_min_samples");
+	p.rbf.max_samples = par.getInt("rbf_max_samples");
+	p.rbf.overlap = par.getFloat("rbf_overlap");
+	p.rbf.off_surface = par.getFloat("rbf_off_surface");
 	p.memory_limit = 1e9 * par.getFloat("memory_limit");
 
 	ib::CoreMesh surface, holes;
@@ -273,6 +306,7 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 		log("Input had no usable normals (or estimation was requested): estimated them from %d "
 			"neighbours and oriented them by propagation%s.",
 			p.normal_neighbours, r.normals_flipped ? " (flipped to point away from the centroid)" : "");
+	log("Implicit function: %s, built in %.2f s.", qUtf8Printable(kImplicits[int(p.implicit)]), r.seconds_implicit);
 	log("Lattice %dx%dx%d, cell %g (resolution %d%s, sample spacing %g).",
 		r.lattice_cells[0], r.lattice_cells[1], r.lattice_cells[2], r.cell_size, r.resolution,
 		r.resolution_automatic ? ", automatic" : "", r.sample_spacing);

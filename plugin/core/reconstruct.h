@@ -9,6 +9,7 @@
 #include "boundary_trim.h"
 #include "gated_mc.h"
 #include "implicit/hoppe.h"
+#include "implicit/pu_rbf.h"
 #include "memory_budget.h"
 #include "normals.h"
 #include "pinches.h"
@@ -23,6 +24,7 @@
 #include <Eigen/Eigenvalues>
 
 #include <chrono>
+#include <memory>
 #ifdef __GLIBC__
 #include <malloc.h>
 #endif
@@ -40,6 +42,30 @@ class InputError : public std::runtime_error
 {
 public:
     using std::runtime_error::runtime_error;
+};
+
+/// Forwards a stage's own 0..100 progress into a range of the caller's callback. VCG's
+/// callback is a plain function pointer, so the range lives in thread-local state; stages
+/// report from the calling thread only.
+class ProgressRange
+{
+public:
+    /// A callback mapping 0..100 into [lo, hi] of `target`, or null when target is null.
+    static vcg::CallBackPos* Into(vcg::CallBackPos* target, int lo, int hi)
+    {
+        target_ = target;
+        lo_ = lo;
+        hi_ = hi;
+        return target ? &Forward : nullptr;
+    }
+
+private:
+    static bool Forward(const int pos, const char* what)
+    {
+        return target_(lo_ + (hi_ - lo_) * std::clamp(pos, 0, 100) / 100, what);
+    }
+    static inline thread_local vcg::CallBackPos* target_ = nullptr;
+    static inline thread_local int lo_ = 0, hi_ = 100;
 };
 
 class Reconstruction
@@ -65,6 +91,11 @@ public:
     static constexpr double kCellPerSpacing = 0.6;
 
     enum class NormalSource { LayerOrEstimate, Estimate };
+    /// The implicit function whose zero set is extracted.
+    enum class Implicit {
+        PuRbf,  ///< partition-of-unity RBF (paper §4, pu_rbf.h)
+        Hoppe   ///< blended signed distance to the nearest tangent planes (hoppe.h)
+    };
     /// What a sample marks in the SODS before dilation.
     enum class Occupancy {
         TangentDisks,  ///< cells crossed by the sample's tangent disk (radius from local spacing)
@@ -80,6 +111,8 @@ public:
         NormalSource normals = NormalSource::LayerOrEstimate;
         int normal_neighbours = 10;  ///< k for normal estimation
         std::optional<Eigen::Vector3d> viewpoint;  ///< orient estimated normals towards it
+        Implicit implicit = Implicit::Hoppe;
+        PuRbf::Param rbf;            ///< the PU-RBF's cells and fits (threads: taken from `threads`)
         int hoppe_neighbours = 8;    ///< tangent planes blended by the signed distance
         /// Holes whose loops all have fewer edges are undersampling: their hole triangles are
         /// added to the surface (paper §3.1). 0 keeps every hole.
@@ -150,7 +183,8 @@ public:
         const SampleIndex samples(P);
         const Eigen::VectorXd spacing = SampleSpacing::Local(samples, 1, p.threads);
         r.sample_spacing = SampleSpacing::Median(spacing);
-        HoppeDistance f(samples, normals, p.hoppe_neighbours, p.threads);
+        const std::unique_ptr<ImplicitFunction> implicit = MakeImplicit(P, normals, samples, p, cb);
+        const ImplicitFunction& f = *implicit;
         r.seconds_implicit = seconds(t);
 
         t = Clock::now();
@@ -175,9 +209,9 @@ public:
         // Before the SODS: a surface of n samples at spacing s covers about n·s² / cell² cells.
         const double expectedCells = 2.0 * double(P.rows()) * std::pow(r.sample_spacing / cell, 2);
         CheckMemory(p.extraction, lattice, expectedCells, r);
-        if (cb) cb(8, "Building the spatial occupancy data structure");
+        if (cb) cb(36, "Building the spatial occupancy data structure");
         Sods sods = p.occupancy == Occupancy::TangentDisks
-                        ? Sods::FromDisks(lattice, P, normals, p.sample_radius * spacing,
+                        ? Sods::FromDisks(lattice, OnZeroSet(P, normals, f), normals, p.sample_radius * spacing,
                                           kDiskSlack * lattice.cell_size, p.threads)
                         : Sods::FromSamples(lattice, P);
         for (int i = 0; i < p.sods_dilation; ++i)
@@ -192,7 +226,8 @@ public:
         surface.Clear();
         GatedMarchingCubes::Param mp;
         mp.extraction = p.extraction;
-        const GatedMarchingCubes::Result mc = GatedMarchingCubes::Compute(lattice, sods, f, surface, mp, cb);
+        const GatedMarchingCubes::Result mc =
+            GatedMarchingCubes::Compute(lattice, sods, f, surface, mp, ProgressRange::Into(cb, 40, 96));
         r.evaluations = mc.evaluations;
         r.crossed_corners = mc.crossed_corners;
         r.hole_cells = mc.hole_cells;
@@ -210,6 +245,32 @@ public:
         ReleaseFreedMemory();  // before the host copies the surface
         r.seconds_boundaries = seconds(t);
         return r;
+    }
+
+    /// The samples moved along their normals onto the implicit surface (one Newton step, f
+    /// being close to a signed distance): the tangent disks are laid where the surface to be
+    /// extracted is, not where the noisy or smoothed-over samples are. A fitted function (the
+    /// PU-RBF) passes up to about a spacing away from samples at sharp or noisy spots.
+    static Points OnZeroSet(const Points& P, const Points& N, const ImplicitFunction& f)
+    {
+        Eigen::VectorXd value(P.rows());
+        f.Eval(P, value);
+        return (P.array() - N.array().colwise() * value.array()).matrix();
+    }
+
+    /// The implicit function p asks for, fitted to the samples P with unit normals N.
+    static std::unique_ptr<ImplicitFunction> MakeImplicit(const Points& P, const Points& N, const SampleIndex& samples,
+                                                          const Param& p, vcg::CallBackPos* cb)
+    {
+        if (p.implicit == Implicit::Hoppe)
+            return std::make_unique<HoppeDistance>(samples, N, p.hoppe_neighbours, p.threads);
+        PuRbf::Param rp = p.rbf;
+        rp.threads = p.threads;
+        try {
+            return std::make_unique<PuRbf>(P, N, rp, ProgressRange::Into(cb, 5, 35));
+        } catch (const std::invalid_argument& e) {
+            throw InputError(e.what());
+        }
     }
 
     /// Unit normals: the layer's, or estimated ones (and says so in r).
@@ -405,6 +466,15 @@ private:
             throw InputError("Boundary smoothing must be between 0 and 100 iterations (4 is the paper's choice).");
         if (!(p.boundary_trim >= 0 && p.boundary_trim <= 8))
             throw InputError("The boundary trim must be between 0 (off) and 8 sample spacings.");
+        if (p.rbf.min_samples < 4 || p.rbf.min_samples > 2000)
+            throw InputError("The PU-RBF's minimum samples per cell must be between 4 and 2000 (50 is the paper's).");
+        if (p.rbf.max_samples < std::max(8, p.rbf.min_samples / 4) || p.rbf.max_samples > 5000)
+            throw InputError("The PU-RBF's maximum samples per cell must be between 8 and 5000 and not far below "
+                             "the minimum (160 is the paper's).");
+        if (!(p.rbf.overlap >= 1 && p.rbf.overlap <= 4))
+            throw InputError("The PU-RBF's overlap must be between 1 (no overlap) and 4 (1.5 is the default).");
+        if (!(p.rbf.off_surface > 0 && p.rbf.off_surface <= 4))
+            throw InputError("The PU-RBF's off-surface distance must be above 0 and at most 4 sample spacings.");
         if (!(p.memory_limit >= 0))
             throw InputError("The memory limit cannot be negative (0 = half the physical memory).");
         if (p.min_boundary_edges < 0)
