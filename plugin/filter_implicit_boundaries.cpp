@@ -1,5 +1,6 @@
 #include "filter_implicit_boundaries.h"
 
+#include "core/implicit/mesh_distance.h"
 #include "core/reconstruct.h"
 
 #include <vcg/complex/algorithms/update/selection.h>
@@ -12,7 +13,7 @@ const QStringList kNormalSources = {"Use layer normals", "Estimate"};
 // Order matches ib::Reconstruction::Occupancy.
 const QStringList kOccupancies = {"Tangent disks", "Sample cells (paper)"};
 // Order matches ib::Reconstruction::Implicit.
-const QStringList kImplicits = {"PU-RBF (paper)", "Hoppe signed distance"};
+const QStringList kImplicits = {"PU-RBF (paper)", "Hoppe signed distance", "Mesh layer (signed distance)"};
 // Order matches ib::GatedMarchingCubes::Extraction.
 const QStringList kExtractions = {"SODS-driven", "Full lattice, gated", "Plain marching cubes"};
 
@@ -40,6 +41,42 @@ QString loopSummary(const std::vector<ib::BoundaryLoop>& loops)
 	for (const auto& l : loops)
 		sizes << QString::number(l.Edges());
 	return loops.empty() ? QString("none") : sizes.join(", ");
+}
+
+/// The signed distance to the mesh layer `id`, or an MLException saying why it cannot be one.
+std::unique_ptr<ib::MeshDistance> implicitMesh(MeshDocument& md, unsigned int id)
+{
+	MeshModel* model = md.getMesh(id);
+	if (model == nullptr)
+		throw MLException("The implicit mesh layer does not exist: choose a mesh layer as 'Implicit mesh layer'.");
+	if (model->cm.fn == 0)
+		throw MLException(QString("The implicit mesh layer '%1' has no faces: choose a closed triangle mesh, e.g. the "
+								  "output of Screened Poisson on the points.")
+							  .arg(model->label()));
+	// Read around deleted elements rather than compacting: the user's layer stays untouched.
+	const CMeshO& cm = model->cm;
+	std::vector<int> row(cm.vert.size(), -1);
+	ib::Points V(cm.vn, 3);
+	int n = 0;
+	for (size_t i = 0; i < cm.vert.size(); ++i)
+		if (!cm.vert[i].IsD()) {
+			V.row(n) << cm.vert[i].cP()[0], cm.vert[i].cP()[1], cm.vert[i].cP()[2];
+			row[i] = n++;
+		}
+	Eigen::Matrix<int, Eigen::Dynamic, 3, Eigen::RowMajor> F(cm.fn, 3);
+	int m = 0;
+	for (const auto& f : cm.face)
+		if (!f.IsD()) {
+			for (int k = 0; k < 3; ++k)
+				F(m, k) = row[vcg::tri::Index(cm, f.cV(k))];
+			++m;
+		}
+	try {
+		return std::make_unique<ib::MeshDistance>(V, F);
+	}
+	catch (const std::invalid_argument& e) {
+		throw MLException(QString("The implicit mesh layer '%1' cannot be used: %2.").arg(model->label(), e.what()));
+	}
 }
 
 } // namespace
@@ -110,15 +147,15 @@ int FilterImplicitBoundariesPlugin::postCondition(const QAction*) const
 	return MeshModel::MM_NONE;
 }
 
-RichParameterList FilterImplicitBoundariesPlugin::initParameterList(const QAction* action, const MeshModel& m)
+RichParameterList FilterImplicitBoundariesPlugin::initParameterList(const QAction* action, const MeshDocument& md)
 {
 	switch (ID(action)) {
-	case IMPLICIT_RECONSTRUCTION_WITH_BOUNDARIES: return reconstructionParameters(m);
+	case IMPLICIT_RECONSTRUCTION_WITH_BOUNDARIES: return reconstructionParameters(md);
 	default: assert(0); return RichParameterList();
 	}
 }
 
-RichParameterList FilterImplicitBoundariesPlugin::reconstructionParameters(const MeshModel&) const
+RichParameterList FilterImplicitBoundariesPlugin::reconstructionParameters(const MeshDocument& md) const
 {
 	const ib::Reconstruction::Param d;
 	RichParameterList par;
@@ -137,7 +174,13 @@ RichParameterList FilterImplicitBoundariesPlugin::reconstructionParameters(const
 		"fitted to the samples and their normals in overlapping octree cells, blended by a "
 		"partition of unity (Tobor et al. 2006): smooth and close to the samples. 'Hoppe signed "
 		"distance': blended distance to the nearest samples' tangent planes (Hoppe et al. 1992): "
-		"no fitting, follows noise more closely."));
+		"no fitting, follows noise more closely. 'Mesh layer (signed distance)': the closed mesh "
+		"chosen below, e.g. the output of Screened Poisson, gets the scan's real boundaries."));
+	par.addParam(RichMesh(
+		"implicit_mesh", md.mm() ? md.mm()->id() : 0, &md, "Implicit mesh layer",
+		"With 'Mesh layer (signed distance)': the closed triangle mesh whose surface is extracted "
+		"where the point layer has samples (run Screened Poisson on the points first). Ignored "
+		"by the other implicit functions."));
 	par.addParam(RichInt(
 		"rbf_min_samples", d.rbf.min_samples, "PU-RBF: min samples per cell",
 		"Each local RBF sees at least this many samples (its support grows where the scan is "
@@ -264,6 +307,12 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 	p.rbf.overlap = par.getFloat("rbf_overlap");
 	p.rbf.off_surface = par.getFloat("rbf_off_surface");
 	p.memory_limit = 1e9 * par.getFloat("memory_limit");
+
+	std::unique_ptr<ib::MeshDistance> meshImplicit;
+	if (p.implicit == ib::Reconstruction::Implicit::Given) {
+		meshImplicit = implicitMesh(md, par.getMeshId("implicit_mesh"));
+		p.given = meshImplicit.get();
+	}
 
 	ib::CoreMesh surface, holes;
 	ib::Reconstruction::Result r;

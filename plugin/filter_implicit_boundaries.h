@@ -25,7 +25,7 @@ public:
 	FilterArity filterArity(const QAction*) const;
 	int getPreConditions(const QAction*) const;
 	int postCondition(const QAction*) const;
-	RichParameterList initParameterList(const QAction*, const MeshModel& m);
+	RichParameterList initParameterList(const QAction*, const MeshDocument& md);
 	std::map<std::string, QVariant> applyFilter(
 		const QAction*           action,
 		const RichParameterList& parameters,
@@ -34,7 +34,7 @@ public:
 		vcg::CallBackPos*        cb);
 
 private:
-	RichParameterList reconstructionParameters(const MeshModel& m) const;
+	RichParameterList reconstructionParameters(const MeshDocument& md) const;
 	std::map<std::string, QVariant> reconstructWithBoundaries(
 		MeshDocument& md, const RichParameterList& par, vcg::CallBackPos* cb);
 };

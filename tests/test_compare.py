@@ -163,7 +163,7 @@ def test_pictures_show_boundaries_hole_triangles_and_unsupported_faces(holed_sph
     _, folder, _ = holed_sphere
     pixels = np.asarray(Image.open(folder / "side_by_side.png").convert("RGB"))
     views = np.array_split(pixels[:int(pixels.shape[0] * 2 / 2.2)], 2, axis=0)  # above the legend strip
-    (ours, poisson, _), (ours_back, _, _) = (np.array_split(v, 3, axis=1) for v in views)
+    (ours, poisson, *_), (ours_back, *_) = (np.array_split(v, len(METHODS), axis=1) for v in views)
     front, back = colour_counts(ours), colour_counts(ours_back)
     assert front["red"] > 300 and front["blue"] > 2000 and front["orange"] == 0
     assert back["red"] == back["blue"] == 0  # the holes face the first view

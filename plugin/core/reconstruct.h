@@ -94,7 +94,8 @@ public:
     /// The implicit function whose zero set is extracted.
     enum class Implicit {
         PuRbf,  ///< partition-of-unity RBF (paper §4, pu_rbf.h)
-        Hoppe   ///< blended signed distance to the nearest tangent planes (hoppe.h)
+        Hoppe,  ///< blended signed distance to the nearest tangent planes (hoppe.h)
+        Given   ///< Param::given, e.g. the signed distance to a closed mesh (mesh_distance.h)
     };
     /// What a sample marks in the SODS before dilation.
     enum class Occupancy {
@@ -114,6 +115,7 @@ public:
         Implicit implicit = Implicit::Hoppe;
         PuRbf::Param rbf;            ///< the PU-RBF's cells and fits (threads: taken from `threads`)
         int hoppe_neighbours = 8;    ///< tangent planes blended by the signed distance
+        const ImplicitFunction* given = nullptr;  ///< used with Implicit::Given; not owned
         /// Holes whose loops all have fewer edges are undersampling: their hole triangles are
         /// added to the surface (paper §3.1). 0 keeps every hole.
         int min_boundary_edges = kDefaultMinBoundaryEdges;
@@ -183,8 +185,9 @@ public:
         const SampleIndex samples(P);
         const Eigen::VectorXd spacing = SampleSpacing::Local(samples, 1, p.threads);
         r.sample_spacing = SampleSpacing::Median(spacing);
-        const std::unique_ptr<ImplicitFunction> implicit = MakeImplicit(P, normals, samples, p, cb);
-        const ImplicitFunction& f = *implicit;
+        const std::unique_ptr<ImplicitFunction> fitted =
+            p.implicit == Implicit::Given ? nullptr : MakeImplicit(P, normals, samples, p, cb);
+        const ImplicitFunction& f = fitted ? *fitted : *p.given;
         r.seconds_implicit = seconds(t);
 
         t = Clock::now();
@@ -466,6 +469,8 @@ private:
             throw InputError("Boundary smoothing must be between 0 and 100 iterations (4 is the paper's choice).");
         if (!(p.boundary_trim >= 0 && p.boundary_trim <= 8))
             throw InputError("The boundary trim must be between 0 (off) and 8 sample spacings.");
+        if (p.implicit == Implicit::Given && p.given == nullptr)
+            throw InputError("No implicit function was given: choose a mesh layer as the implicit surface.");
         if (p.rbf.min_samples < 4 || p.rbf.min_samples > 2000)
             throw InputError("The PU-RBF's minimum samples per cell must be between 4 and 2000 (50 is the paper's).");
         if (p.rbf.max_samples < std::max(8, p.rbf.min_samples / 4) || p.rbf.max_samples > 5000)

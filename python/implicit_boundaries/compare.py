@@ -16,6 +16,7 @@ import pymeshlab
 from scipy.spatial import cKDTree
 
 from . import metrics
+from .poisson import poisson_with_boundaries
 from ._plugin import apply, load
 
 Progress = Callable[[int, int, str], None]  # (steps done, steps in all, what comes next)
@@ -119,11 +120,24 @@ def run_poisson_trimmed(cloud: Cloud, settings: Settings) -> Surface:
     return Surface(vertices, density_trim(faces, density, settings.trim_quantile))
 
 
+def run_poisson_with_boundaries(cloud: Cloud, settings: Settings) -> Surface:
+    """MeshLab's screened Poisson surface as our filter's implicit function: Poisson's
+    surface where the samples are, with the scan's boundaries."""
+    ms = _meshset(cloud)
+    depth = settings.depth or (poisson_depth(settings.resolution) if settings.resolution else 8)
+    info = dict(poisson_with_boundaries(ms, depth=depth, poisson_threads=settings.poisson_threads,
+                                        resolution=settings.resolution, hole_layer=True, **settings.params))
+    vertices, faces = _copy(ms.mesh(2))
+    holes = _copy(ms.mesh(3)) if ms.mesh_number() > 3 else None
+    return Surface(vertices, faces, holes, info)
+
+
 # Ours first: the others run at the resolution it chose.
 METHODS: Dict[str, Callable[[Cloud, Settings], Surface]] = {
     "ours": run_ours,
     "screened Poisson": run_poisson,
     "screened Poisson + density trim": run_poisson_trimmed,
+    "screened Poisson + our boundaries": run_poisson_with_boundaries,
 }
 
 

@@ -1,0 +1,131 @@
+// Signed distance to a mesh as the implicit function: an icosphere, with and without a crack.
+#include "geometry.h"
+#include "implicit/mesh_distance.h"
+#include "reconstruct.h"
+
+#include <vcg/complex/algorithms/create/platonic.h>
+
+#include <gtest/gtest.h>
+
+using namespace ib;
+
+namespace {
+using Faces = Eigen::Matrix<int, Eigen::Dynamic, 3, Eigen::RowMajor>;
+
+/// An icosphere of radius 1 (subdivided 4 times: 5120 faces), outward-oriented.
+void Icosphere(Points& V, Faces& F)
+{
+    CoreMesh m;
+    vcg::tri::Sphere(m, 4);
+    V.resize(Eigen::Index(m.vert.size()), 3);
+    for (size_t i = 0; i < m.vert.size(); ++i)
+        V.row(Eigen::Index(i)) << m.vert[i].cP()[0], m.vert[i].cP()[1], m.vert[i].cP()[2];
+    F.resize(Eigen::Index(m.face.size()), 3);
+    for (size_t i = 0; i < m.face.size(); ++i)
+        for (int k = 0; k < 3; ++k)
+            F(Eigen::Index(i), k) = int(vcg::tri::Index(m, m.face[i].cV(k)));
+}
+
+/// Points on random rays at the given radii.
+Points Shell(int n, double radius, unsigned seed)
+{
+    std::srand(seed);
+    Points Q(n, 3);
+    for (int i = 0; i < n; ++i) {
+        Eigen::Vector3d d = Eigen::Vector3d::Random().normalized();
+        Q.row(i) = (radius * d).transpose();
+    }
+    return Q;
+}
+} // namespace
+
+TEST(MeshDistance, IsTheSignedDistanceToAClosedMesh)
+{
+    Points V;
+    Faces F;
+    Icosphere(V, F);
+    const MeshDistance f(V, F);
+    EXPECT_EQ(f.Statistics().border_edges, 0);
+    for (double r : {0.3, 0.9, 0.99, 1.01, 1.2, 3.0}) {
+        const Points Q = Shell(500, r, 7);
+        Eigen::VectorXd v(Q.rows());
+        f.Eval(Q, v);
+        // The icosphere's faces lie within 0.0025 inside the unit sphere.
+        EXPECT_LT((v.array() - (r - 1)).abs().maxCoeff(), 0.003) << r;
+        EXPECT_TRUE(r < 1 ? (v.array() < 0).all() : (v.array() > 0).all()) << r;
+    }
+}
+
+TEST(MeshDistance, KeepsAUsableSignAcrossACrack)
+{
+    // Remove a strip of faces: the mesh is open, the sign must still be right near it.
+    Points V;
+    Faces F;
+    Icosphere(V, F);
+    std::vector<int> kept;
+    for (Eigen::Index i = 0; i < F.rows(); ++i) {
+        const Eigen::Vector3d c = (V.row(F(i, 0)) + V.row(F(i, 1)) + V.row(F(i, 2))).transpose() / 3;
+        if (!(std::abs(c[0]) < 0.03 && c[2] > 0.5))
+            kept.push_back(int(i));
+    }
+    const Faces cracked = F(kept, Eigen::all);
+    ASSERT_LT(cracked.rows(), F.rows());
+    const MeshDistance f(V, cracked);
+    EXPECT_GT(f.Statistics().border_edges, 0);
+    int wrong = 0, total = 0;
+    for (double r : {0.9, 0.95, 1.05, 1.1}) {
+        const Points Q = Shell(2000, r, 11);
+        Eigen::VectorXd v(Q.rows());
+        f.Eval(Q, v);
+        for (Eigen::Index i = 0; i < Q.rows(); ++i, ++total)
+            wrong += (v[i] < 0) != (r < 1);
+    }
+    EXPECT_EQ(wrong, 0) << " of " << total;
+}
+
+TEST(MeshDistance, RejectsUnusableMeshes)
+{
+    const Points V = Points::Random(5, 3);
+    EXPECT_THROW(MeshDistance(V, Faces(0, 3)), std::invalid_argument);
+    Faces bad(1, 3);
+    bad << 0, 1, 7;
+    EXPECT_THROW(MeshDistance(V, bad), std::invalid_argument);
+    Faces flat(1, 3);
+    flat << 0, 0, 1;
+    EXPECT_THROW(MeshDistance(V, flat), std::invalid_argument);
+}
+
+TEST(MeshDistance, SamplesOnHalfTheSphereGiveOneLoopAtTheRim)
+{
+    Points V;
+    Faces F;
+    Icosphere(V, F);
+    const MeshDistance sphere(V, F);
+    Points P, N;
+    test::SpherePoints(4000, 1.0, P, N, 0.0);  // the upper half only
+    Reconstruction::Param p;
+    p.implicit = Reconstruction::Implicit::Given;
+    p.given = &sphere;
+    p.resolution = 40;
+    CoreMesh m;
+    const auto r = Reconstruction::Compute(P, N, p, m);
+    ASSERT_EQ(r.loops.size(), 1u);
+    double rimError = 0;
+    for (int v : r.loops[0].vertices)
+        rimError = std::max(rimError, std::abs(m.vert[size_t(v)].cP()[2]));
+    EXPECT_LT(rimError, 1.5 * r.cell_size);  // the rim is the equator
+    // The surface follows the mesh (within a fraction of a cell) and stays on the sampled half.
+    double off = 0, lowest = 1;
+    for (const auto& v : m.vert) {
+        off = std::max(off, std::abs(v.cP().Norm() - 1));
+        lowest = std::min(lowest, v.cP()[2]);
+    }
+    EXPECT_LT(off, 0.1 * r.cell_size);
+    EXPECT_GT(lowest, -1.5 * r.cell_size);
+    const auto t = test::Check(m);
+    EXPECT_EQ(t.non_manifold_edges, 0);
+    EXPECT_TRUE(t.oriented);
+
+    p.given = nullptr;
+    EXPECT_THROW(Reconstruction::Compute(P, N, p, m), InputError);
+}
