@@ -17,6 +17,7 @@ import numpy as np
 import pymeshlab
 
 import implicit_boundaries
+from implicit_boundaries import poisson_with_boundaries
 from implicit_boundaries.compare import density_trim, poisson_depth
 from implicit_boundaries.metrics import boundary_distance, boundary_vertex_sets, loops_found
 
@@ -71,6 +72,8 @@ def reference_loops(name, points, normals, resolution):
     t = time.perf_counter()
     if name == "ball pivoting":
         ms.generate_surface_reconstruction_ball_pivoting()
+    elif name == "screened Poisson + our boundaries":
+        poisson_with_boundaries(ms, depth=poisson_depth(resolution), resolution=resolution)
     else:
         ms.generate_surface_reconstruction_screened_poisson(depth=poisson_depth(resolution))
     seconds = time.perf_counter() - t
@@ -92,7 +95,12 @@ def references(args):
         for label, points in [("clean", clean), ("noise 0.2%", clean + rng.normal(0, 0.002 * diagonal, clean.shape))]:
             ours, _, found, spurious, distance = run(points, normals, truth, 0, {})
             rows = [("ours", ours["boundary_loops"], found, spurious, distance)]
-            for method in ["screened Poisson", "screened Poisson + 5% density trim", "ball pivoting"]:
+            for method in ["screened Poisson", "screened Poisson + 5% density trim", "screened Poisson + our boundaries",
+                           "PU-RBF + our boundaries", "ball pivoting"]:
+                if method == "PU-RBF + our boundaries":
+                    pu, _, found, spurious, distance = run(points, normals, truth, 0, {"implicit": "PU-RBF (paper)"})
+                    rows.append((method, pu["boundary_loops"], found, spurious, distance))
+                    continue
                 loops, _ = reference_loops(method, points, normals, ours["resolution"])
                 found, spurious = loops_found(truth, loops, 2.5 * ours["sample_spacing"] + 2 * ours["cell_size"])
                 rows.append((method, len(loops), found, spurious, boundary_distance(truth, loops)))
