@@ -31,7 +31,7 @@ test-python: plugin
 # Builds MeshLab 2025.07d (cached outside the repo) and checks that it loads our plugin.
 gui: plugin
 	.ci/install-deps gui
-	tests/gui/check_plugin_loads.sh "$$(.ci/meshlab-gui)" python/implicit_boundaries/lib/libfilter_implicit_boundaries.so
+	tests/gui/apply_filter_in_meshlab.sh "$$(.ci/meshlab-gui)" python/implicit_boundaries/lib/libfilter_implicit_boundaries.so
 	@echo "Start MeshLab with the plugin: $$(.ci/meshlab-gui)/meshlab"
 	@echo "then Filters > Remeshing, Simplification and Reconstruction > Implicit reconstruction with boundaries"
 

@@ -114,15 +114,19 @@ QString FilterImplicitBoundariesPlugin::filterInfo(ActionIDType filter) const
 {
 	switch (filter) {
 	case IMPLICIT_RECONSTRUCTION_WITH_BOUNDARIES:
-		return "Reconstructs a surface <b>with its real boundaries</b> from a point cloud. "
-			   "An implicit function (the signed distance to the samples' tangent planes, "
-			   "Hoppe et al. 1992) is extracted by marching cubes, but only inside the cells of a "
-			   "<i>spatial occupancy data structure</i> (SODS): the lattice cells that hold samples, "
-			   "grown by their 26-neighbourhood. Where the scan has no samples (the underside of an "
-			   "object on a table, a cut), no surface is made, unlike screened Poisson, which closes "
-			   "every hole.<br>The boundary loops found are reported (edge counts) and their "
-			   "vertices are left selected.<br>Method: Reconstructing implicit surfaces with "
-			   "boundaries using a spatial occupancy data structure (SODS-gated marching cubes).";
+		return "Reconstructs a surface <b>with its real boundaries</b> from a point cloud with normals "
+			   "(estimated when the layer has none). An implicit function is fitted to the samples "
+			   "(Hoppe's signed distance to tangent planes, the paper's partition-of-unity RBF, or the "
+			   "signed distance to a closed mesh layer such as Screened Poisson's output) and extracted "
+			   "by marching cubes, but only in the cells of a <i>spatial occupancy data structure</i> "
+			   "(SODS): the lattice cells covered by the samples' tangent disks. Where the scan has no "
+			   "samples (the underside of an object on a table, a cut) no surface is made, unlike "
+			   "Screened Poisson, which closes every hole. Holes with short boundaries are "
+			   "undersampling and are filled; the others are kept, trimmed to the scan's edge and "
+			   "smoothed. The boundary loops are reported (edge counts, lengths) and their vertices "
+			   "left selected; the hole triangles can go to their own layer.<br>Method: "
+			   "<i>Reconstructing implicit surfaces with boundaries</i> (SODS-gated marching cubes), "
+			   "see the plugin's README.";
 	default: assert(0); return QString();
 	}
 }
