@@ -54,15 +54,7 @@ public:
         return std::move(parts[0]);
     }
 
-    void Insert(const Index3& c)
-    {
-        Brick& b = bricks_[BrickKey(c)];
-        const int bit = BitOf(c);
-        if (!(b[bit >> 6] & (uint64_t(1) << (bit & 63)))) {
-            b[bit >> 6] |= uint64_t(1) << (bit & 63);
-            ++count_;
-        }
-    }
+    void Insert(const Index3& c) { Set(bricks_[BrickKey(c)], c); }
 
     bool Contains(const Index3& c) const
     {
@@ -83,13 +75,23 @@ public:
         const double reach = r + a * std::sqrt(3.0);
         const Eigen::Vector3d box = Eigen::Vector3d::Constant(std::max(r, slack));
         const Index3 lo = lattice.CellOf(p - box), hi = lattice.CellOf(p + box);
+        // Neighbouring cells mostly share a brick: keep the last one instead of hashing each
+        // cell (map elements do not move when the map grows).
+        uint64_t lastKey = ~uint64_t(0);
+        Brick* brick = nullptr;
         for (int z = lo[2]; z <= hi[2]; ++z)
             for (int y = lo[1]; y <= hi[1]; ++y)
                 for (int x = lo[0]; x <= hi[0]; ++x) {
                     const Eigen::Vector3d d = lattice.Corner(x, y, z) + Eigen::Vector3d::Constant(a) - p;
                     const double h = n.dot(d);
-                    if (std::abs(h) <= slab && (d - h * n).norm() <= reach)
-                        Insert(Index3(x, y, z));
+                    if (std::abs(h) <= slab && (d - h * n).norm() <= reach) {
+                        const Index3 c(x, y, z);
+                        if (BrickKey(c) != lastKey) {
+                            lastKey = BrickKey(c);
+                            brick = &bricks_[lastKey];
+                        }
+                        Set(*brick, c);
+                    }
                 }
         Insert(lattice.CellOf(p));
     }
@@ -154,6 +156,16 @@ public:
 private:
     static constexpr int kBrick = 8;
     using Brick = std::array<uint64_t, kBrick * kBrick * kBrick / 64>;
+
+    /// Marks cell c in its brick b.
+    void Set(Brick& b, const Index3& c)
+    {
+        const int bit = BitOf(c);
+        if (!(b[bit >> 6] & (uint64_t(1) << (bit & 63)))) {
+            b[bit >> 6] |= uint64_t(1) << (bit & 63);
+            ++count_;
+        }
+    }
 
     static uint64_t BrickKey(const Index3& c) { return PackIndex(c[0] >> 3, c[1] >> 3, c[2] >> 3); }
     static int BitOf(const Index3& c) { return (c[0] & 7) | ((c[1] & 7) << 3) | ((c[2] & 7) << 6); }
