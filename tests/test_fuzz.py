@@ -269,3 +269,71 @@ def run_recipe(worker, recipe, params):
 @given(recipe=clouds(), params=parameters())
 def test_random_clouds_and_parameters(worker, recipe, params):
     run_recipe(worker, recipe, params)
+
+
+# ---------------------------------------------------------------------------------------------
+# Edge inputs named one by one (README's table of refused inputs points here), through the same
+# crash-safe child.
+
+def flat_scan(n=600, scale=1.0, offset=0.0, seed=1):
+    """A square of n samples in the plane z = 0 with their normals: points, normals."""
+    rng = np.random.default_rng(seed)
+    return np.column_stack([rng.random((n, 2)), np.zeros(n)]) * scale + offset, np.tile([0, 0, 1.0], (n, 1))
+
+
+def with_row(array, row, value):
+    out = array.copy()
+    out[row] = value
+    return out
+
+
+REFUSED = {
+    "infinite coordinate": (lambda: (with_row(flat_scan()[0], 5, [np.inf, 0, 0]), None), {},
+                            "1 of 600 vertices have NaN or infinite"),
+    "one zero normal": (lambda: (flat_scan()[0], with_row(flat_scan()[1], 5, 0)), {}, "1 of 600 vertex normals are zero or NaN"),
+    "one NaN normal": (lambda: (flat_scan()[0], with_row(flat_scan()[1], 5, np.nan)), {}, "zero or NaN"),
+    "resolution 7": (flat_scan, dict(resolution=7), "Resolution 7 is out of range"),
+    "dilation 9": (flat_scan, dict(sods_dilation=9), "SODS dilation must be between 0 and 8"),
+    "radius 8.5": (flat_scan, dict(sample_radius=8.5), "sample radius must be between 0.25 and 8"),
+    "min_boundary_edges -1": (flat_scan, dict(min_boundary_edges=-1), "minimum number of boundary edges cannot be negative"),
+    "smoothing 101": (flat_scan, dict(boundary_smoothing=101), "Boundary smoothing must be between 0 and 100"),
+    "trim 9": (flat_scan, dict(boundary_trim=9.0), "boundary trim must be between 0"),
+    "rbf_min_samples 3": (flat_scan, dict(rbf_min_samples=3), "minimum samples per cell must be between 4 and 2000"),
+    "rbf_max_samples 7": (flat_scan, dict(rbf_max_samples=7), "maximum samples per cell must be between 8 and 5000"),
+    "rbf_overlap 0.5": (flat_scan, dict(rbf_overlap=0.5), "overlap must be between 1"),
+    "rbf_off_surface 0": (flat_scan, dict(rbf_off_surface=0.0), "off-surface distance must be above 0"),
+    "mesh layer without faces": (flat_scan, dict(implicit="Mesh layer (signed distance)", implicit_mesh=0),
+                                 "has no faces"),
+}
+
+
+@pytest.mark.parametrize("name", REFUSED)
+def test_refused_inputs(worker, name):
+    make, params, message = REFUSED[name]
+    points, normals = make()
+    answer = worker.run(points, normals, params)
+    check_answer(answer, params)
+    assert answer["status"] == "refused" and message in answer["message"], answer.get("message")
+
+
+ACCEPTED = {  # the issue's odd but valid inputs: a surface comes out
+    "flat scan": (flat_scan, {}),
+    "tiny coordinates (1e-6)": (lambda: flat_scan(scale=1e-6), {}),
+    "huge coordinates (1e6)": (lambda: flat_scan(scale=1e6), {}),
+    "unit scan far from the origin (1e6)": (lambda: flat_scan(offset=1e6), {}),
+    "every sample three times": (lambda: tuple(np.tile(a, (3, 1)) for a in flat_scan()), {}),
+    "all normals zero (estimated)": (lambda: (flat_scan()[0], np.zeros((600, 3))), {}),
+    "flat scan, PU-RBF": (flat_scan, dict(implicit="PU-RBF (paper)")),
+}
+
+
+@pytest.mark.parametrize("name", ACCEPTED)
+def test_odd_but_valid_inputs_give_a_surface(worker, name):
+    make, params = ACCEPTED[name]
+    points, normals = make()
+    answer = worker.run(points, normals, params)
+    check_answer(answer, params)
+    assert answer["status"] == "ok", answer.get("message")
+    # the surface spans the scan, at its scale
+    extent = np.ptp(answer["vertices"], axis=0)
+    assert 0.8 * np.ptp(points, axis=0)[0] < extent[0] < 1.2 * np.ptp(points, axis=0)[0]
