@@ -48,14 +48,15 @@ def _serve(conn):
         job = conn.recv()
         if job is None:
             return
-        points, normals, params = job
         try:
-            conn.send(_run(pymeshlab, implicit_boundaries, points, normals, params))
+            conn.send(_run(pymeshlab, implicit_boundaries, *job))
         except Exception:  # a bug in the harness or in pymeshlab's own checks: show it whole
             conn.send({"status": "harness error", "message": traceback.format_exc()})
 
 
-def _run(pymeshlab, implicit_boundaries, points, normals, params):
+def _run(pymeshlab, implicit_boundaries, points, normals, params, mesh_layer=None):
+    """One filter call on a new MeshSet holding the points (layer 0) and, when given, a mesh
+    (vertices, faces) as layer 1 for the implicit_mesh parameter."""
     ms = pymeshlab.MeshSet()
     if len(points) == 0:  # pymeshlab makes no mesh from an empty matrix, but loads an empty file
         import tempfile
@@ -69,12 +70,16 @@ def _run(pymeshlab, implicit_boundaries, points, normals, params):
         ms.add_mesh(pymeshlab.Mesh(vertex_matrix=points), "points")
     else:
         ms.add_mesh(pymeshlab.Mesh(vertex_matrix=points, v_normals_matrix=normals), "points")
+    if mesh_layer is not None:
+        ms.add_mesh(pymeshlab.Mesh(vertex_matrix=mesh_layer[0], face_matrix=mesh_layer[1]), "mesh")
+        ms.set_current_mesh(0)
+    layers = ms.mesh_number()
     try:
         result = implicit_boundaries.apply(ms, **params)
     except pymeshlab.PyMeshLabException as e:
-        return {"status": "refused", "message": str(e), "layers": ms.mesh_number()}
+        return {"status": "refused", "message": str(e), "new_layers": ms.mesh_number() - layers}
     out = ms.current_mesh()
-    return {"status": "ok", "layers": ms.mesh_number(), "current": ms.current_mesh_id(),
+    return {"status": "ok", "surface_layer": layers, "new_layers": ms.mesh_number() - layers, "current": ms.current_mesh_id(),
             "vertices": out.vertex_matrix().copy(), "faces": out.face_matrix().copy(),
             "selected": np.flatnonzero(out.vertex_selection_array()),
             "result": {k: (np.asarray(v) if isinstance(v, (list, np.ndarray)) else v) for k, v in result.items()}}
@@ -93,10 +98,10 @@ class Worker:
         self.process.start()
         child_end.close()
 
-    def run(self, points, normals, params):
+    def run(self, points, normals, params, mesh_layer=None):
         if self.process is None or not self.process.is_alive():
             self.start()
-        self.conn.send((points, normals, params))
+        self.conn.send((points, normals, params, mesh_layer))
         if not self.conn.poll(CHILD_TIMEOUT):
             self.stop()
             return {"status": "hang", "message": f"no answer within {CHILD_TIMEOUT} s"}
@@ -240,13 +245,13 @@ def check_loops(vertices, faces, result, selected):
 def check_answer(answer, params):
     status = answer["status"]
     assert status in ("ok", "refused"), f"{status}: {answer['message']}"
-    expected_layers = 1 + (status == "ok") * (1 + bool(params.get("hole_layer")))
-    assert answer["layers"] == expected_layers, f"{answer['layers']} layers after a {status} run"
+    expected = (status == "ok") * (1 + bool(params.get("hole_layer")))
+    assert answer["new_layers"] == expected, f"{answer['new_layers']} new layers after a {status} run"
     if status == "refused":
         assert answer["message"].strip(), "refused without a message"
         return
     vertices, faces, result = answer["vertices"], answer["faces"], answer["result"]
-    assert answer["current"] == 1, "the new surface is not the current layer"
+    assert answer["current"] == answer["surface_layer"], "the new surface is not the current layer"
     assert len(faces) > 0, "an empty surface returned as a result"
     assert np.all((faces >= 0) & (faces < len(vertices)))
     assert result["surface_faces"] == len(faces) and result["surface_vertices"] == len(vertices)
@@ -304,14 +309,17 @@ REFUSED = {
     "rbf_off_surface 0": (flat_scan, dict(rbf_off_surface=0.0), "off-surface distance must be above 0"),
     "mesh layer without faces": (flat_scan, dict(implicit="Mesh layer (signed distance)", implicit_mesh=0),
                                  "has no faces"),
+    "mesh layer of degenerate faces": (flat_scan, dict(implicit="Mesh layer (signed distance)", implicit_mesh=1),
+                                       "only degenerate (zero-area) faces"),
 }
+MESH_LAYERS = {"mesh layer of degenerate faces": (np.zeros((3, 3)), np.array([[0, 1, 2]], dtype=np.int32))}
 
 
 @pytest.mark.parametrize("name", REFUSED)
 def test_refused_inputs(worker, name):
     make, params, message = REFUSED[name]
     points, normals = make()
-    answer = worker.run(points, normals, params)
+    answer = worker.run(points, normals, params, MESH_LAYERS.get(name))
     check_answer(answer, params)
     assert answer["status"] == "refused" and message in answer["message"], answer.get("message")
 
