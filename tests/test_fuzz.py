@@ -357,9 +357,17 @@ DEFAULT_PARAMS = {"resolution": 0, "implicit": "Hoppe signed distance", "sods_oc
                   "hole_layer": False}
 SMALL_CLUSTER = {"n": 10, "shapes": ["cluster"], "scale": 1.0, "offset": 0.0, "duplicates": 0, "nans": 0,
                  "normals": "none", "seed": 0}
+THREE_CLUSTERS = {**SMALL_CLUSTER, "n": 1455, "shapes": ["cluster"] * 3, "seed": 1116}
+PLAIN_OVER_CLUSTERS = dict(sods_occupancy="Sample cells (paper)", sods_dilation=1, min_boundary_edges=0,
+                           boundary_trim=1.0, extraction="Plain marching cubes", normals="Estimate")
 FOUND = {
     # 10 scattered samples: every face was trimmed or filled away and an empty layer was added
     "empty surface": (SMALL_CLUSTER, dict(min_boundary_edges=28), "No surface was extracted"),
+    # Plain marching cubes over three clusters: VCG's centre vertex of ambiguous cells was held
+    # by pointer while edge vertices were added (use after free): a segfault, or faces on a
+    # stray vertex (not a manifold)
+    "centre vertex, segfault": (THREE_CLUSTERS, dict(PLAIN_OVER_CLUSTERS, sample_radius=4.0, boundary_trim=4.0), None),
+    "centre vertex, not manifold": (THREE_CLUSTERS, PLAIN_OVER_CLUSTERS, None),
 }
 
 
