@@ -386,25 +386,39 @@ private:
         void GetYIntercept(const vcg::Point3i& a, const vcg::Point3i& b, CoreVertex*& v) { v = Intercept(a, b, 1); }
         void GetZIntercept(const vcg::Point3i& a, const vcg::Point3i& b, CoreVertex*& v) { v = Intercept(a, b, 2); }
 
-        /// Asked for the centre vertex of ambiguous cases: every crossed edge of the cell gets
-        /// its vertex, so the centre does not depend on the order cells are visited.
+        /// Asked for the centre vertex of ambiguous cases: every crossed edge of the cell gives
+        /// its crossing point, so the centre does not depend on the order cells are visited.
+        /// VCG only reads the position, while it holds the new centre vertex by pointer: adding
+        /// the edge vertex to the mesh here could reallocate the vertices under that pointer
+        /// (a use after free found by fuzzing), so a scratch vertex carries the position.
         bool Exist(const vcg::Point3i& a, const vcg::Point3i& b, CoreVertex*& v)
         {
             const bool ina = V(a[0], a[1], a[2]) > 0, inb = V(b[0], b[1], b[2]) > 0;
-            v = ina != inb ? Intercept(a, b, a[0] != b[0] ? 0 : a[1] != b[1] ? 1 : 2) : nullptr;
-            return v != nullptr;
+            v = nullptr;
+            if (ina == inb)
+                return false;
+            const Eigen::Vector3d p = EdgePoint(a, b);
+            scratch_.P() = vcg::Point3d(p[0], p[1], p[2]);
+            v = &scratch_;
+            return true;
         }
 
     private:
+        /// Where f crosses zero on the lattice edge a-b (linear interpolation).
+        Eigen::Vector3d EdgePoint(const vcg::Point3i& a, const vcg::Point3i& b) const
+        {
+            const double fa = values_(PackIndex(a[0], a[1], a[2])), fb = values_(PackIndex(b[0], b[1], b[2]));
+            const double t = fa / (fa - fb);
+            const Eigen::Vector3d pa = lattice_.Corner(a[0], a[1], a[2]), pb = lattice_.Corner(b[0], b[1], b[2]);
+            return pa + t * (pb - pa);
+        }
+
         CoreVertex* Intercept(const vcg::Point3i& a, const vcg::Point3i& b, int axis)
         {
             const uint64_t ka = PackIndex(a[0], a[1], a[2]), kb = PackIndex(b[0], b[1], b[2]);
             auto [it, fresh] = edges_.try_emplace(std::min(ka, kb) << 2 | uint64_t(axis), mesh_.vert.size());
             if (fresh) {
-                const double fa = values_(ka), fb = values_(kb);
-                const double t = fa / (fa - fb);
-                const Eigen::Vector3d pa = lattice_.Corner(a[0], a[1], a[2]), pb = lattice_.Corner(b[0], b[1], b[2]);
-                const Eigen::Vector3d p = pa + t * (pb - pa);
+                const Eigen::Vector3d p = EdgePoint(a, b);
                 auto vi = vcg::tri::Allocator<CoreMesh>::AddVertices(mesh_, 1);
                 vi->P() = vcg::Point3d(p[0], p[1], p[2]);
             }
@@ -415,6 +429,7 @@ private:
         CoreMesh& mesh_;
         const CornerValues& values_;
         std::unordered_map<uint64_t, size_t> edges_;
+        CoreVertex scratch_;
     };
 };
 

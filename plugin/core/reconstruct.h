@@ -244,6 +244,11 @@ public:
         if (holes)
             Split(surface, inSurface, 0, *holes);
         KeepSurface(surface, inSurface);
+        // An empty layer would look like success: say why nothing came out instead.
+        if (surface.face.empty())
+            throw InputError("No surface was extracted at resolution " + std::to_string(r.resolution) +
+                             ": the samples are too few or too scattered to outline a surface. Try a lower "
+                             "resolution, a larger sample radius or SODS dilation, or more samples.");
         r.loops = BoundaryLoops::Compute(surface);
         ReleaseFreedMemory();  // before the host copies the surface
         r.seconds_boundaries = seconds(t);
