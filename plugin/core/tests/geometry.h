@@ -3,6 +3,7 @@
 
 #include "lattice.h"
 #include "mesh.h"
+#include "sods.h"
 #include "implicit/implicit_function.h"
 
 #include <vcg/complex/algorithms/clean.h>
@@ -47,6 +48,17 @@ public:
 private:
     double r_;
 };
+
+/// A SODS covering every cell of l: gated extraction then equals plain marching cubes.
+inline Sods AllCells(const Lattice& l)
+{
+    Sods s(l.cells);
+    for (int z = 0; z < l.cells[2]; ++z)
+        for (int y = 0; y < l.cells[1]; ++y)
+            for (int x = 0; x < l.cells[0]; ++x)
+                s.Insert(Index3(x, y, z));
+    return s;
+}
 
 struct Topology
 {

@@ -5,24 +5,11 @@
 
 using namespace ib;
 
-namespace {
-// A SODS covering every cell: gated extraction then equals plain marching cubes.
-Sods AllCells(const Lattice& l)
-{
-    Sods s(l.cells);
-    for (int z = 0; z < l.cells[2]; ++z)
-        for (int y = 0; y < l.cells[1]; ++y)
-            for (int x = 0; x < l.cells[0]; ++x)
-                s.Insert(Index3(x, y, z));
-    return s;
-}
-} // namespace
-
 TEST(GatedMarchingCubes, SphereIsAClosedOrientedManifoldOnTheSphere)
 {
     const Lattice l = Lattice::Fit(Eigen::Vector3d(-1, -1, -1), Eigen::Vector3d(1, 1, 1), 24, 2);
     CoreMesh m;
-    const auto stats = GatedMarchingCubes::Compute(l, AllCells(l), test::SphereDistance(1.0), m);
+    const auto stats = GatedMarchingCubes::Compute(l, test::AllCells(l), test::SphereDistance(1.0), m);
     EXPECT_EQ(stats.evaluations, size_t(l.CornerCount()));
     ASSERT_GT(m.fn, 1000);
 
@@ -50,7 +37,7 @@ TEST(GatedMarchingCubes, EmitsTrianglesOnlyInSodsCells)
 {
     const Lattice l = Lattice::Fit(Eigen::Vector3d(-1, -1, -1), Eigen::Vector3d(1, 1, 1), 16, 2);
     Sods upper(l.cells);  // cells whose centre is above z = 0.3
-    AllCells(l).ForEach([&](const Index3& c) {
+    test::AllCells(l).ForEach([&](const Index3& c) {
         if (l.Corner(c[0], c[1], c[2])[2] + 0.5 * l.cell_size > 0.3)
             upper.Insert(c);
     });
@@ -72,7 +59,7 @@ TEST(GatedMarchingCubes, HoleTrianglesCloseTheSurfaceAndShareItsVertices)
     // so the cap gets two holes: the big bottom opening and a small one at the top.
     const Lattice l = Lattice::Fit(Eigen::Vector3d(-1, -1, -1), Eigen::Vector3d(1, 1, 1), 20, 2);
     Sods gated(l.cells);
-    AllCells(l).ForEach([&](const Index3& c) {
+    test::AllCells(l).ForEach([&](const Index3& c) {
         const Eigen::Vector3d centre = l.Corner(c[0], c[1], c[2]) + Eigen::Vector3d::Constant(0.5 * l.cell_size);
         if (centre[2] > 0.3 && centre.head<2>().norm() > 0.25)
             gated.Insert(c);
@@ -106,7 +93,7 @@ TEST(GatedMarchingCubes, HoleRegionReachingTheLatticeBorderIsOpen)
     };
     const Lattice l = Lattice::Fit(Eigen::Vector3d(-1, -1, -1), Eigen::Vector3d(1, 1, 1), 12, 1);
     Sods middle(l.cells);
-    AllCells(l).ForEach([&](const Index3& c) {
+    test::AllCells(l).ForEach([&](const Index3& c) {
         if ((l.Corner(c[0], c[1], c[2]) + Eigen::Vector3d::Constant(0.5 * l.cell_size)).norm() < 0.5)
             middle.Insert(c);
     });
@@ -144,7 +131,7 @@ TEST(GatedMarchingCubes, TheThreeExtractionsAgreeInSodsCells)
     // A sphere gated by a tilted slab: open surface, two hole regions.
     const Lattice l = Lattice::Fit(Eigen::Vector3d(-1, -1, -1), Eigen::Vector3d(1, 1, 1), 22, 2);
     Sods slab(l.cells);
-    AllCells(l).ForEach([&](const Index3& c) {
+    test::AllCells(l).ForEach([&](const Index3& c) {
         const Eigen::Vector3d centre = l.Corner(c[0], c[1], c[2]) + Eigen::Vector3d::Constant(0.5 * l.cell_size);
         if (std::abs(centre[0] + 0.3 * centre[2]) < 0.6)
             slab.Insert(c);
@@ -193,7 +180,7 @@ TEST(GatedMarchingCubes, LeanFaceFaceAdjacencyEqualsVcgs)
     // are the ones vcg::tri::UpdateTopology::FaceFace finds.
     const Lattice l = Lattice::Fit(Eigen::Vector3d(-1, -1, -1), Eigen::Vector3d(1, 1, 1), 18, 2);
     Sods upper(l.cells);
-    AllCells(l).ForEach([&](const Index3& c) {
+    test::AllCells(l).ForEach([&](const Index3& c) {
         if (l.Corner(c[0], c[1], c[2])[2] > -0.2)
             upper.Insert(c);
     });

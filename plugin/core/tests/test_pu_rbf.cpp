@@ -404,18 +404,6 @@ TEST(PuRbf, ProgressIsMonotoneFromZeroToHundred)
     EXPECT_TRUE(std::is_sorted(progress.begin(), progress.end()));
 }
 
-namespace {
-Sods AllCells(const Lattice& l)
-{
-    Sods s(l.cells);
-    for (int z = 0; z < l.cells[2]; ++z)
-        for (int y = 0; y < l.cells[1]; ++y)
-            for (int x = 0; x < l.cells[0]; ++x)
-                s.Insert(Index3(x, y, z));
-    return s;
-}
-} // namespace
-
 TEST(PuRbf, MarchingCubesExtractsTheSphere)
 {
     Points P, N;
@@ -425,7 +413,7 @@ TEST(PuRbf, MarchingCubesExtractsTheSphere)
     CoreMesh m;
     GatedMarchingCubes::Param noHoles;
     noHoles.holes = false;
-    GatedMarchingCubes::Compute(l, AllCells(l), f, m, noHoles);
+    GatedMarchingCubes::Compute(l, test::AllCells(l), f, m, noHoles);
     ASSERT_GT(m.fn, 1000);
     double worst = 0, sum = 0;
     for (const auto& v : m.vert) {
@@ -453,7 +441,7 @@ TEST(PuRbf, MarchingCubesExtractsTheNoisyTorusWithoutSpuriousSheets)
     CoreMesh m;
     GatedMarchingCubes::Param noHoles;
     noHoles.holes = false;
-    GatedMarchingCubes::Compute(l, AllCells(l), f, m, noHoles);
+    GatedMarchingCubes::Compute(l, test::AllCells(l), f, m, noHoles);
     ASSERT_GT(m.fn, 1000);
     const Shape torus = Torus(1.0, 0.35);
     const SampleIndex samples(P);

@@ -97,22 +97,27 @@ TEST(Reconstruction, RejectsBadInputWithClearMessages)
 TEST(Reconstruction, SameOutputOnOneAndTwoThreads)
 {
     Points P, N;
-    test::SpherePoints(5000, 1.0, P, N, -0.3);  // open: holes, trim and smoothing all run
-    Reconstruction::Param one, two;
-    one.threads = 1;
-    two.threads = 2;
-    CoreMesh m1, m2;
-    const auto r1 = Reconstruction::Compute(P, N, one, m1);
-    const auto r2 = Reconstruction::Compute(P, N, two, m2);
-    ASSERT_EQ(m1.vert.size(), m2.vert.size());
-    ASSERT_EQ(m1.face.size(), m2.face.size());
-    for (size_t i = 0; i < m1.vert.size(); ++i)
-        ASSERT_EQ(m1.vert[i].cP(), m2.vert[i].cP()) << i;  // bit for bit, same order
-    for (size_t i = 0; i < m1.face.size(); ++i)
-        for (int k = 0; k < 3; ++k)
-            ASSERT_EQ(vcg::tri::Index(m1, m1.face[i].cV(k)), vcg::tri::Index(m2, m2.face[i].cV(k)));
-    ASSERT_EQ(r1.loops.size(), r2.loops.size());
-    EXPECT_EQ(r1.loops[0].vertices, r2.loops[0].vertices);
+    test::SpherePoints(4000, 1.0, P, N, -0.3);  // open: holes, trim and smoothing all run
+    for (auto implicit : {Reconstruction::Implicit::Hoppe, Reconstruction::Implicit::PuRbf}) {
+        Reconstruction::Param one, two;
+        one.implicit = two.implicit = implicit;
+        one.threads = 1;
+        two.threads = 2;
+        CoreMesh m1, m2;
+        const auto r1 = Reconstruction::Compute(P, N, one, m1);
+        const auto r2 = Reconstruction::Compute(P, N, two, m2);
+        ASSERT_GT(m1.face.size(), 0u);
+        ASSERT_EQ(m1.vert.size(), m2.vert.size());
+        ASSERT_EQ(m1.face.size(), m2.face.size());
+        for (size_t i = 0; i < m1.vert.size(); ++i)
+            ASSERT_EQ(m1.vert[i].cP(), m2.vert[i].cP()) << i;  // bit for bit, same order
+        for (size_t i = 0; i < m1.face.size(); ++i)
+            for (int k = 0; k < 3; ++k)
+                ASSERT_EQ(vcg::tri::Index(m1, m1.face[i].cV(k)), vcg::tri::Index(m2, m2.face[i].cV(k)));
+        ASSERT_EQ(r1.loops.size(), r2.loops.size());
+        for (size_t i = 0; i < r1.loops.size(); ++i)
+            EXPECT_EQ(r1.loops[i].vertices, r2.loops[i].vertices) << i;
+    }
 }
 
 TEST(Reconstruction, FullLatticeExtractionsMatchTheSodsDrivenOne)
@@ -177,26 +182,3 @@ TEST(Reconstruction, RefusesRunsOverTheMemoryLimit)
     }
 }
 
-TEST(Reconstruction, PuRbfSameOutputOnOneAndTwoThreads)
-{
-    Points P, N;
-    test::SpherePoints(3000, 1.0, P, N, -0.3);  // open: holes, trim and smoothing all run
-    Reconstruction::Param one, two;
-    one.implicit = two.implicit = Reconstruction::Implicit::PuRbf;
-    one.threads = 1;
-    two.threads = 2;
-    CoreMesh m1, m2;
-    const auto r1 = Reconstruction::Compute(P, N, one, m1);
-    const auto r2 = Reconstruction::Compute(P, N, two, m2);
-    ASSERT_GT(m1.face.size(), 0u);
-    ASSERT_EQ(m1.vert.size(), m2.vert.size());
-    ASSERT_EQ(m1.face.size(), m2.face.size());
-    for (size_t i = 0; i < m1.vert.size(); ++i)
-        ASSERT_EQ(m1.vert[i].cP(), m2.vert[i].cP()) << i;  // bit for bit, same order
-    for (size_t i = 0; i < m1.face.size(); ++i)
-        for (int k = 0; k < 3; ++k)
-            ASSERT_EQ(vcg::tri::Index(m1, m1.face[i].cV(k)), vcg::tri::Index(m2, m2.face[i].cV(k)));
-    ASSERT_EQ(r1.loops.size(), r2.loops.size());
-    for (size_t i = 0; i < r1.loops.size(); ++i)
-        EXPECT_EQ(r1.loops[i].vertices, r2.loops[i].vertices) << i;
-}
