@@ -16,7 +16,6 @@
 #include "sods.h"
 #include "spacing.h"
 
-#include <vcg/complex/algorithms/update/topology.h>
 #include <vcg/complex/append.h>
 #include <vcg/complex/algorithms/clean.h>
 #include <vcg/complex/algorithms/update/selection.h>
