@@ -19,7 +19,7 @@ import pymeshlab
 import implicit_boundaries
 from implicit_boundaries import poisson_with_boundaries
 from implicit_boundaries.compare import density_trim, poisson_depth
-from implicit_boundaries.metrics import boundary_distance, boundary_vertex_sets, loops_found
+from implicit_boundaries.metrics import boundary_curves, boundary_distance, boundary_vertex_sets, loops_found
 
 DEFAULT_DATA = Path(__file__).resolve().parent.parent.parent / "shared" / "data"
 CASES = ["bun_zipper.ply", "mech-holes-shark.off", "fandisk_truncated.off", "tum_rabbit.ply", "gargoyle.ply"]
@@ -28,6 +28,8 @@ METHODS = {
     "ours, no smoothing": {"boundary_smoothing": 0},
     "ours, no trim": {"boundary_trim": 0.0},
     "ours, no trim, no smoothing": {"boundary_trim": 0.0, "boundary_smoothing": 0},
+    "ours, no fit": {"boundary_fit": False},
+    "ours, no fit, no smoothing": {"boundary_fit": False, "boundary_smoothing": 0},
     "ours, min_boundary_edges 0": {"min_boundary_edges": 0},
     "paper SODS (cells + 1 ring), smoothing 4": {"sods_occupancy": "Sample cells (paper)", "sods_dilation": 1,
                                                  "boundary_trim": 0.0},
@@ -45,7 +47,12 @@ def load_case(path):
     return m.vertex_matrix().copy(), m.vertex_normal_matrix().copy(), m.face_matrix().copy()
 
 
-def run(points, normals, truth, resolution, params):
+def curves(vertices, faces):
+    """Boundary curves sampled every 0.05% of the bounding-box diagonal of the vertices."""
+    return boundary_curves(vertices, faces, 0.0005 * np.linalg.norm(np.ptp(vertices, axis=0)))
+
+
+def run(points, normals, truth, truth_curves, resolution, params):
     ms = pymeshlab.MeshSet()
     ms.add_mesh(pymeshlab.Mesh(vertex_matrix=points, v_normals_matrix=normals), "points")
     t = time.perf_counter()
@@ -54,7 +61,8 @@ def run(points, normals, truth, resolution, params):
     vertices = ms.current_mesh().vertex_matrix()
     loops = [vertices[l] for l in implicit_boundaries.loops_from_result(out)]
     found, spurious = loops_found(truth, loops, 2.5 * out["sample_spacing"] + 2 * out["cell_size"])
-    return out, seconds, found, spurious, boundary_distance(truth, loops)
+    distance = boundary_distance(truth_curves, curves(vertices, ms.current_mesh().face_matrix()))
+    return out, seconds, found, spurious, distance
 
 
 def poisson_seconds(points, normals, resolution):
@@ -66,7 +74,7 @@ def poisson_seconds(points, normals, resolution):
 
 
 def reference_loops(name, points, normals, resolution):
-    """Boundary loops (point arrays) and seconds of a MeshLab reference method."""
+    """Boundary loops (point arrays), boundary curves and seconds of a MeshLab reference method."""
     ms = pymeshlab.MeshSet()
     ms.add_mesh(pymeshlab.Mesh(vertex_matrix=points, v_normals_matrix=normals), "points")
     t = time.perf_counter()
@@ -81,7 +89,7 @@ def reference_loops(name, points, normals, resolution):
     vertices, faces = m.vertex_matrix(), m.face_matrix()
     if name == "screened Poisson + 5% density trim":
         faces = density_trim(faces, m.vertex_scalar_array(), 0.05)  # Poisson's density is the vertex quality
-    return [vertices[h] for h in boundary_vertex_sets(faces, len(vertices))], seconds
+    return [vertices[h] for h in boundary_vertex_sets(faces, len(vertices))], curves(vertices, faces), seconds
 
 
 def references(args):
@@ -91,19 +99,21 @@ def references(args):
     for name in CASES:
         clean, normals, faces = load_case(args.data / name)
         truth = [clean[h] for h in boundary_vertex_sets(faces, len(clean))]
+        truth_curves = curves(clean, faces)
         diagonal = np.linalg.norm(clean.max(0) - clean.min(0))
         for label, points in [("clean", clean), ("noise 0.2%", clean + rng.normal(0, 0.002 * diagonal, clean.shape))]:
-            ours, _, found, spurious, distance = run(points, normals, truth, 0, {})
+            ours, _, found, spurious, distance = run(points, normals, truth, truth_curves, 0, {})
             rows = [("ours", ours["boundary_loops"], found, spurious, distance)]
             for method in ["screened Poisson", "screened Poisson + 5% density trim", "screened Poisson + our boundaries",
                            "PU-RBF + our boundaries", "ball pivoting"]:
                 if method == "PU-RBF + our boundaries":
-                    pu, _, found, spurious, distance = run(points, normals, truth, 0, {"implicit": "PU-RBF (paper)"})
+                    pu, _, found, spurious, distance = run(points, normals, truth, truth_curves, 0,
+                                                           {"implicit": "PU-RBF (paper)"})
                     rows.append((method, pu["boundary_loops"], found, spurious, distance))
                     continue
-                loops, _ = reference_loops(method, points, normals, ours["resolution"])
+                loops, found_curves, _ = reference_loops(method, points, normals, ours["resolution"])
                 found, spurious = loops_found(truth, loops, 2.5 * ours["sample_spacing"] + 2 * ours["cell_size"])
-                rows.append((method, len(loops), found, spurious, boundary_distance(truth, loops)))
+                rows.append((method, len(loops), found, spurious, boundary_distance(truth_curves, found_curves)))
             for method, count, found, spurious, distance in rows:
                 print(f"| {name} | {label} | {method} | {count} ({len(truth)}) | {found}/{len(truth)} "
                       f"| {sum(s >= 10 for s in spurious)} / {len(spurious)} | {100 * distance / diagonal:.3f} |")
@@ -124,10 +134,11 @@ def main(argv=None):
         points, normals, faces = load_case(args.data / name)
         diagonal = np.linalg.norm(points.max(0) - points.min(0))
         truth = [points[h] for h in boundary_vertex_sets(faces, len(points))]
+        truth_curves = curves(points, faces)
         resolutions = [0, 100] if name == "bun_zipper.ply" else [0]
         for resolution in resolutions:
             for method, params in METHODS.items():
-                out, seconds, found, spurious, distance = run(points, normals, truth, resolution, params)
+                out, seconds, found, spurious, distance = run(points, normals, truth, truth_curves, resolution, params)
                 ratio = seconds / poisson_seconds(points, normals, out["resolution"])
                 edges = out["boundary_loop_edges"].astype(int).tolist()
                 print(f"| {name} | {len(points)} | {len(truth)} | {method} | {out['resolution']} | {len(edges)} "

@@ -238,8 +238,16 @@ RichParameterList FilterImplicitBoundariesPlugin::reconstructionParameters(const
 	par.addParam(RichFloat(
 		"boundary_trim", d.boundary_trim, "Boundary trim (spacings)",
 		"Faces at the boundary farther than this many local sample spacings from every sample "
-		"are peeled off, removing the margin the occupancy adds past the scan's edge. Lower it "
-		"to cut tighter (below 0.6 it may bite into sparse regions); 0 = no trim.",
+		"are peeled off, removing the margin the occupancy adds past the scan's edge; the "
+		"boundary fit then moves the boundary out onto the last samples. Raise it if the trim "
+		"opens spurious holes in sparse regions; 0 = no trim.",
+		true));
+	par.addParam(RichBool(
+		"boundary_fit", d.boundary_fit, "Fit boundary to the samples' edge",
+		"Moves each boundary vertex along the surface onto the outermost samples beside it, so "
+		"the boundary follows the scan's edge instead of the lattice's cells (measured: the "
+		"boundary distance to the true one drops by a third). Turn it off to see the boundary "
+		"the trim leaves.",
 		true));
 	par.addParam(RichBool(
 		"hole_layer", false, "Hole triangles in their own layer",
@@ -301,6 +309,7 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 	p.min_boundary_edges = par.getInt("min_boundary_edges");
 	p.boundary_trim = par.getFloat("boundary_trim");
 	p.boundary_smoothing = par.getInt("boundary_smoothing");
+	p.boundary_fit = par.getBool("boundary_fit");
 	const bool holeLayer = par.getBool("hole_layer");
 	p.occupancy = ib::Reconstruction::Occupancy(par.getEnum("sods_occupancy"));
 	p.sample_radius = par.getFloat("sample_radius");
@@ -368,9 +377,10 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 			"to their spacing (separate clusters?). Set the resolution by hand if the result is too coarse.",
 			r.resolution);
 	log("Surface: %d faces, %d vertices; %d boundary loops kept (edges: %s); %d small holes "
-		"filled (loops under %d edges); %zu unsupported faces trimmed off the boundary.",
+		"filled (loops under %d edges); %zu unsupported faces trimmed off the boundary, %zu "
+		"boundary vertices fitted to the samples' edge.",
 		out->cm.fn, out->cm.vn, int(r.loops.size()), qUtf8Printable(loopSummary(r.loops)),
-		r.holes_filled, p.min_boundary_edges, r.faces_trimmed);
+		r.holes_filled, p.min_boundary_edges, r.faces_trimmed, r.boundary_vertices_fitted);
 	log("%s extraction: %zu SODS cells, %zu hole cells%s; %zu implicit evaluations (the full "
 		"lattice has %.0f corners, the cells the surface crosses %zu).",
 		qUtf8Printable(kExtractions[int(p.extraction)]), r.sods_cells, r.hole_cells,
@@ -387,6 +397,7 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 	res["holes_filled"] = r.holes_filled;
 	res["hole_cells"] = double(r.hole_cells);
 	res["faces_trimmed"] = double(r.faces_trimmed);
+	res["boundary_vertices_fitted"] = double(r.boundary_vertices_fitted);
 	res["duplicates_removed"] = double(r.duplicates_removed);
 	res["surface_faces"] = out->cm.fn;
 	res["surface_vertices"] = out->cm.vn;

@@ -33,6 +33,34 @@ def torus(R=1.0, r=0.4, spacing=0.035):
     return centre + r * normals, normals
 
 
+def sphere_circle(centre, angle, spacing):
+    """Points on the unit sphere at geodesic distance `angle` from the unit vector `centre`,
+    `spacing` apart (also their outward normals)."""
+    centre = np.asarray(centre, dtype=float)
+    u = np.cross(centre, [1.0, 0, 0] if abs(centre[0]) < 0.9 else [0, 1.0, 0])
+    u /= np.linalg.norm(u)
+    w = np.cross(centre, u)
+    t = np.arange(max(3, int(np.ceil(2 * np.pi * np.sin(angle) / spacing)))) * 2 * np.pi
+    t /= len(t)
+    return np.cos(angle) * centre + np.sin(angle) * (np.cos(t)[:, None] * u + np.sin(t)[:, None] * w)
+
+
+def torus_section(x0, R=1.0, r=0.4, spacing=0.035):
+    """The torus of :func:`torus` cut by the plane x = x0 (|x0| < R - r): its two closed
+    curves as points `spacing` apart along them, and the torus normals there."""
+    v = np.linspace(0, 2 * np.pi, 4000, endpoint=False)
+    rho = R + r * np.cos(v)
+    points, normals = [], []
+    for side in (1, -1):
+        u = side * np.arccos(x0 / rho)
+        curve = np.column_stack([rho * np.cos(u), rho * np.sin(u), r * np.sin(v)])
+        arc = np.concatenate([[0], np.cumsum(np.linalg.norm(np.diff(curve, axis=0), axis=1))])
+        pick = np.unique(np.searchsorted(arc, np.arange(0, arc[-1], spacing)))
+        points.append(curve[pick])
+        normals.append(np.column_stack([np.cos(v) * np.cos(u), np.cos(v) * np.sin(u), np.sin(v)])[pick])
+    return np.concatenate(points), np.concatenate(normals)
+
+
 def check_oriented_manifold(vertices, faces):
     """Asserts that the mesh is a 2-manifold with boundary, consistently oriented, finite."""
     assert np.all(np.isfinite(vertices))

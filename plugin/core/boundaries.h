@@ -65,6 +65,17 @@ public:
         return loops;
     }
 
+    /// Per vertex of `mesh`: how many times the `loops` pass through it. Vertices passed more
+    /// than once are pinch points, where moving the vertex would tear the surface.
+    static std::vector<int> Uses(const CoreMesh& mesh, const std::vector<BoundaryLoop>& loops)
+    {
+        std::vector<int> uses(mesh.vert.size(), 0);
+        for (const auto& loop : loops)
+            for (int v : loop.vertices)
+                ++uses[size_t(v)];
+        return uses;
+    }
+
     /// Sum of the edge lengths of `loop` in `mesh`.
     static double Length(const CoreMesh& mesh, const BoundaryLoop& loop)
     {

@@ -5,6 +5,8 @@
 
 #include <vcg/complex/complex.h>
 
+#include <Eigen/Core>
+
 #include <vector>
 
 namespace ib {
@@ -25,6 +27,19 @@ class CoreFace : public vcg::Face<CoreUsedTypes, vcg::face::VertexRef, vcg::face
 class CoreMesh : public vcg::tri::TriMesh<std::vector<CoreVertex>, std::vector<CoreFace>>
 {
 };
+
+/// Position of vertex v of m.
+inline Eigen::Vector3d PositionOf(const CoreMesh& m, int v)
+{
+    const auto& q = m.vert[size_t(v)].cP();
+    return Eigen::Vector3d(q[0], q[1], q[2]);
+}
+
+/// Moves vertex v of m to p.
+inline void MoveVertex(CoreMesh& m, int v, const Eigen::Vector3d& p)
+{
+    m.vert[size_t(v)].P() = vcg::Point3d(p[0], p[1], p[2]);
+}
 
 /// Face-face adjacency of an edge-manifold mesh (marching cubes output), the same as
 /// vcg::tri::UpdateTopology::FaceFace gives (a border edge points to its own face), found

@@ -5,6 +5,7 @@
 /// Throws ib::InputError, with a message that says what is wrong and what to do, on bad input.
 
 #include "boundaries.h"
+#include "boundary_fit.h"
 #include "boundary_smoothing.h"
 #include "boundary_trim.h"
 #include "gated_mc.h"
@@ -88,6 +89,8 @@ public:
     /// the boundaries: measured on the Stanford bunny scan (bun_zipper, 34,834 samples), 0.6
     /// finds all 5 holes as single loops (1.0 merges the smallest into undersampling noise).
     static constexpr double kCellPerSpacing = 0.6;
+    /// Pieces of surface with fewer faces left by the trim are removed (a few cells' worth).
+    static constexpr size_t kMinPieceFaces = 10;
 
     enum class NormalSource { LayerOrEstimate, Estimate };
     /// The implicit function whose zero set is extracted.
@@ -120,7 +123,9 @@ public:
         int min_boundary_edges = kDefaultMinBoundaryEdges;
         /// Faces at the boundary farther than this many local spacings from every sample are
         /// peeled off (the margin the SODS adds past the scan's edge). 0 = no trim.
-        double boundary_trim = 0.5;
+        double boundary_trim = 0.25;
+        /// Move the boundary within the surface onto the edge of the samples (boundary_fit.h).
+        bool boundary_fit = true;
         int boundary_smoothing = 4;  ///< iterations of collinearity moves (paper §3.3), 0 = off
         GatedMarchingCubes::Extraction extraction = GatedMarchingCubes::Extraction::SodsDriven;
         /// Refuse runs estimated to need more memory (bytes); 0 = half the physical memory.
@@ -135,6 +140,7 @@ public:
         int holes_filled = 0;             ///< hole regions added to the surface
         size_t faces_trimmed = 0;         ///< unsupported faces peeled off the boundary
         size_t faces_unpinched = 0;       ///< faces of smaller fans removed at pinch vertices
+        size_t boundary_vertices_fitted = 0;  ///< boundary vertices moved onto the samples' edge
         size_t duplicates_removed = 0;    ///< samples at the same position as an earlier one
         size_t hole_cells = 0;
         bool hole_search_capped = false;
@@ -294,7 +300,8 @@ public:
     }
 
     /// The boundary stage on the whole extraction `all` (surface faces first, then hole faces):
-    /// fills small holes, trims, removes pinches and scraps, smooths. Returns which faces are
+    /// fills small holes, trims, removes pinches and scraps, fits the boundary to the samples'
+    /// edge, smooths. Returns which faces are
     /// surface. Smoothing works on surface and hole faces alike, so the holes follow the boundary.
     static std::vector<char> Boundaries(CoreMesh& all, const GatedMarchingCubes::Result& mc, const SampleIndex& samples,
                                         const Eigen::VectorXd& spacing, const ImplicitFunction& f, double cell,
@@ -313,12 +320,21 @@ public:
         if (p.boundary_trim > 0)
             r.faces_trimmed = BoundaryTrim::Compute(all, samples, p.boundary_trim * spacing, inSurface, p.threads);
         r.faces_unpinched = Pinches::Resolve(all, inSurface);
-        if (p.boundary_trim > 0)  // a piece smaller than the smallest hole kept is a scrap of the trim
-            r.faces_trimmed += BoundaryTrim::RemoveScraps(all, inSurface, size_t(p.min_boundary_edges * p.min_boundary_edges / 4));
+        // A piece smaller than the smallest hole kept, or than a few cells when every hole is
+        // kept, is a scrap of the trim.
+        if (p.boundary_trim > 0)
+            r.faces_trimmed += BoundaryTrim::RemoveScraps(
+                all, inSurface, std::max(kMinPieceFaces, size_t(p.min_boundary_edges * p.min_boundary_edges / 4)));
+        const std::vector<BoundaryLoop> loops = BoundaryLoops::Compute(all, inSurface);
+        if (p.boundary_fit) {
+            BoundaryFit::Param fp;
+            fp.cell_size = cell;
+            r.boundary_vertices_fitted = BoundaryFit::Compute(all, loops, inSurface, samples, spacing, &f, fp);
+        }
         BoundarySmoothing::Param sp;
         sp.iterations = p.boundary_smoothing;
         sp.cell_size = cell;
-        BoundarySmoothing::Compute(all, BoundaryLoops::Compute(all, inSurface), &f, sp);
+        BoundarySmoothing::Compute(all, loops, &f, sp);
         return inSurface;
     }
 

@@ -7,18 +7,44 @@ from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
 
+def _boundary_components(faces: np.ndarray, n_vertices: int) -> Tuple[np.ndarray, np.ndarray]:
+    """The boundary edges ((b, 2) vertex pairs) and, per edge, the label of its connected component."""
+    border = boundary_edges(faces)
+    if len(border) == 0:
+        return border, np.zeros(0, dtype=np.int64)
+    graph = sp.coo_matrix((np.ones(len(border)), (border[:, 0], border[:, 1])), shape=(n_vertices, n_vertices))
+    _, label = connected_components(graph, directed=False)
+    return border, label[border[:, 0]]
+
+
 def boundary_vertex_sets(faces: np.ndarray, n_vertices: int) -> List[np.ndarray]:
     """Vertex indices of each boundary component of a triangle mesh (edges used by one face).
 
     faces: (f, 3) vertex indices. Returns one sorted index array per component.
     """
-    border = boundary_edges(faces)
-    if len(border) == 0:
-        return []
-    graph = sp.coo_matrix((np.ones(len(border)), (border[:, 0], border[:, 1])), shape=(n_vertices, n_vertices))
-    _, label = connected_components(graph, directed=False)
-    component = label[border[:, 0]]
+    border, component = _boundary_components(faces, n_vertices)
     return [np.unique(border[component == c]) for c in np.unique(component)]
+
+
+def boundary_curves(vertices: np.ndarray, faces: np.ndarray, step: float) -> List[np.ndarray]:
+    """Each boundary component of a triangle mesh as a curve: points along its edges at most
+    `step` apart, the edges' end points included. A distance between boundaries measured on
+    these does not depend on how finely each mesh happens to be divided along them (a coarse
+    true boundary's vertices can be far apart where the curve itself is close).
+
+    vertices: (n, 3); faces: (f, 3). Returns one (k, 3) point array per component.
+    """
+    vertices = np.asarray(vertices, dtype=np.float64)
+    border, component = _boundary_components(faces, len(vertices))
+    curves = []
+    for c in np.unique(component):
+        a, b = vertices[border[component == c, 0]], vertices[border[component == c, 1]]
+        pieces = np.maximum(1, np.ceil(np.linalg.norm(b - a, axis=1) / step)).astype(np.int64)
+        edge = np.repeat(np.arange(len(a)), pieces)
+        first = np.repeat(np.cumsum(pieces) - pieces, pieces)
+        t = (np.arange(len(edge)) - first) / pieces[edge]
+        curves.append(a[edge] + t[:, None] * (b - a)[edge])
+    return curves
 
 
 def match_loops(true_points: Sequence[np.ndarray], loops: Sequence[np.ndarray], tolerance: float) -> Dict[int, List[int]]:
@@ -49,8 +75,9 @@ def boundary_edges(faces: np.ndarray) -> np.ndarray:
 
 def boundary_distance(truth: Sequence[np.ndarray], loops: Sequence[np.ndarray]) -> float:
     """Symmetric mean distance between the true boundary points and the found loop points
-    (DESIGN.md section 5): each a list of (k, 3) point arrays. 0 when neither side has a
-    boundary, nan when only one has."""
+    (DESIGN.md section 5): each a list of (k, 3) point arrays, best the dense points of
+    :func:`boundary_curves` (then it is the distance between the curves, to within half their
+    step). 0 when neither side has a boundary, nan when only one has."""
     if not len(truth) or not len(loops):
         return float("nan") if len(truth) or len(loops) else 0.0
     t, o = np.concatenate(truth), np.concatenate(loops)

@@ -1,5 +1,6 @@
 // Trim, pinch resolution, scraps and smoothing, on hand-made meshes and a flat scan.
 #include "boundary_trim.h"
+#include "fold_guard.h"
 #include "geometry.h"
 #include "pinches.h"
 #include "reconstruct.h"
@@ -57,10 +58,10 @@ TEST(BoundarySteps, FlatScanIsTrimmedToItsBorderAndSmoothed)
     ASSERT_EQ(r1.loops.size(), 1u);
     const auto [error0, length0] = RimError(m0, r0.loops[0]);
     const auto [error1, length1] = RimError(m1, r1.loops[0]);
-    // Untrimmed, the SODS margin (a tangent disk, 1.25 spacings) shows; trimmed, the boundary
-    // is within 1.5 cells of the square's border and, smoothed, about as long as it (4).
+    // Untrimmed, the SODS margin (a tangent disk, 1.25 spacings) shows; trimmed and fitted, the
+    // boundary is within a cell of the square's border and, smoothed, about as long as it (4).
     EXPECT_GT(error0, 1.5 * r0.cell_size);
-    EXPECT_LT(error1, 1.5 * r1.cell_size);
+    EXPECT_LT(error1, r1.cell_size);
     EXPECT_GT(r1.faces_trimmed, 0u);
     EXPECT_NEAR(length1, 4.0, 0.4);
     EXPECT_GT(length0, length1);
@@ -101,4 +102,33 @@ TEST(BoundarySteps, ScrapsBelowTheSizeAreRemoved)
     EXPECT_EQ(BoundaryTrim::RemoveScraps(m, inSurface, 2), 1u);
     EXPECT_EQ(inSurface.back(), 0);
     EXPECT_EQ(std::count(inSurface.begin(), inSurface.end(), 1), 6);
+}
+
+TEST(BoundarySteps, FoldGuardUndoesAMoveThatFoldsAFace)
+{
+    // A fan of 4 triangles around (0,0,0): moving the centre past the rim folds some of them.
+    CoreMesh m;
+    const vcg::Point3d o(0, 0, 0);
+    for (int i = 0; i < 4; ++i)
+        AddTriangle(m, o, vcg::Point3d(std::cos(i * M_PI / 2), std::sin(i * M_PI / 2), 0),
+                    vcg::Point3d(std::cos((i + 1) * M_PI / 2), std::sin((i + 1) * M_PI / 2), 0));
+    vcg::tri::Clean<CoreMesh>::RemoveDuplicateVertex(m);
+    vcg::tri::Allocator<CoreMesh>::CompactEveryVector(m);
+    int centre = 0;
+    while (PositionOf(m, centre).norm() > 0)
+        ++centre;
+    const std::vector<int> moved{centre};
+    const std::vector<Eigen::Vector3d> start{Eigen::Vector3d::Zero()};
+    MoveVertex(m, centre, Eigen::Vector3d(0.2, 0.1, 0));  // inside the fan: fine
+    EXPECT_EQ(FoldGuard::Restore(m, moved, start), 0u);
+    EXPECT_EQ(PositionOf(m, centre), Eigen::Vector3d(0.2, 0.1, 0));
+    MoveVertex(m, centre, Eigen::Vector3d(1.6, 0, 0));  // past the rim: halved to 0.8, inside again
+    EXPECT_EQ(FoldGuard::Restore(m, moved, start), 1u);
+    EXPECT_NEAR(PositionOf(m, centre)[0], 0.8, 1e-12);
+    MoveVertex(m, centre, Eigen::Vector3d(30, 0, 0));  // 15, 7.5, 3.75 all fold: undone
+    FoldGuard::Restore(m, moved, start);
+    EXPECT_EQ(PositionOf(m, centre), Eigen::Vector3d::Zero());
+    MoveVertex(m, centre, Eigen::Vector3d(1e-3, 0.9999, 0));  // flattens a face to a sliver
+    FoldGuard::Restore(m, moved, start);
+    EXPECT_LT(PositionOf(m, centre)[1], 0.5);
 }

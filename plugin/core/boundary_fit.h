@@ -1,0 +1,170 @@
+#pragma once
+/// \file boundary_fit.h
+/// Moves the boundary, within the surface, onto the edge of the samples. The trim
+/// (boundary_trim.h) removes whole faces beyond a reach, so the boundary it leaves lies
+/// somewhere between that reach and a face past the last samples, while a scan's real edge is
+/// its outermost samples. For each boundary vertex v, with n the surface normal there, o is
+/// the direction in the tangent plane away from the centroid of the samples around v (out of
+/// the surface; it must agree with the loop's orientation). Among those samples that lie
+/// beside v (within a local spacing across o and off the surface), the outermost along o
+/// marks the edge; v moves along o onto it (plus `offset` local spacings), by at most
+/// `max_move` spacings, and the vertices next to v follow (FollowMoves). All targets are computed before any vertex moves; moves that would
+/// fold a face are pulled back (fold_guard.h), after the moved vertices are put back on the
+/// implicit surface (the move is along its tangent plane, implicit_projection.h).
+
+#include "boundaries.h"
+#include "fold_guard.h"
+#include "implicit_projection.h"
+#include "mesh.h"
+#include "samples.h"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <vector>
+
+namespace ib {
+
+class BoundaryFit
+{
+public:
+    struct Param
+    {
+        double offset = 0.0;    ///< boundary beyond the outermost samples, in local spacings
+        double max_move = 1.5;  ///< largest move, in local spacings
+        int neighbours = 16;    ///< samples examined around each boundary vertex
+        int ring_steps = 3;     ///< smoothing steps of the vertices next to the moved ones
+        int newton_steps = 2;   ///< projection steps onto the implicit surface (0 = off)
+        double cell_size = 0;   ///< lattice cell: a projection step moves a vertex by at most one
+    };
+
+    /// Fits the `loops` of the faces f of `mesh` with inSurface[f] (loops traced along the
+    /// faces' orientation, boundaries.h). spacing: per sample of `samples`, its local spacing.
+    /// f: the implicit function the moved vertices are projected on (null: no projection).
+    /// Returns the number of vertices moved (pinch vertices, used twice by the loops, stay).
+    static size_t Compute(CoreMesh& mesh, const std::vector<BoundaryLoop>& loops, const std::vector<char>& inSurface,
+                          const SampleIndex& samples, const Eigen::VectorXd& spacing, const ImplicitFunction* f,
+                          const Param& p)
+    {
+        const std::vector<int> uses = BoundaryLoops::Uses(mesh, loops);
+        const std::vector<Eigen::Vector3d> normal = SurfaceNormals(mesh, inSurface, uses);
+        std::vector<int> moved;
+        std::vector<Eigen::Vector3d> start, target;
+        SampleIndex::Queue queue;
+        for (const auto& loop : loops) {
+            const size_t count = loop.vertices.size();
+            for (size_t i = 0; i < count && count >= 3; ++i) {
+                const int v = loop.vertices[i];
+                if (uses[size_t(v)] != 1)
+                    continue;
+                const Eigen::Vector3d q = PositionOf(mesh, v);
+                const Eigen::Vector3d n = normal[size_t(v)].normalized();
+                const Eigen::Vector3d along =
+                    PositionOf(mesh, loop.vertices[(i + 1) % count]) - PositionOf(mesh, loop.vertices[(i + count - 1) % count]);
+                samples.Nearest(q, p.neighbours, queue);
+                // Out of the surface: away from the samples' centroid, in the tangent plane. A
+                // marching cubes loop zigzags from cell to cell, so its own direction at a
+                // vertex can be 45 degrees off the scan's edge.
+                Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+                const int found = queue.getNofElements();
+                for (int k = 0; k < found; ++k)
+                    centroid += samples.P().row(queue.getIndex(k)).transpose();
+                Eigen::Vector3d out = q - centroid / std::max(found, 1);
+                out = (out - out.dot(n) * n).normalized();
+                if (!out.allFinite() || out.dot(along.cross(n)) <= 0)
+                    continue;  // no clear side (a corner, a narrow strip): leave the vertex
+                const Eigen::Vector3d t = n.cross(out);
+                double edge = -std::numeric_limits<double>::infinity(), h = 0, nearest = std::numeric_limits<double>::infinity();
+                for (int k = 0; k < found; ++k) {
+                    const int s = queue.getIndex(k);
+                    const Eigen::Vector3d d = samples.P().row(s).transpose() - q;
+                    if (queue.getWeight(k) < nearest) {
+                        nearest = queue.getWeight(k);
+                        h = spacing[s];
+                    }
+                    if (std::abs(d.dot(t)) <= spacing[s] && std::abs(d.dot(n)) <= spacing[s])
+                        edge = std::max(edge, d.dot(out));
+                }
+                if (!std::isfinite(edge) || !(h > 0))
+                    continue;
+                const double step = std::clamp(edge + p.offset * h, -p.max_move * h, p.max_move * h);
+                moved.push_back(v);
+                start.push_back(q);
+                target.push_back(q + step * out);
+            }
+        }
+        for (size_t i = 0; i < moved.size(); ++i)
+            MoveVertex(mesh, moved[i], target[i]);
+        const size_t fitted = moved.size();
+        FollowMoves(mesh, uses, p.ring_steps, moved, start);
+        if (f && p.newton_steps > 0 && p.cell_size > 0)
+            ImplicitProjection::Compute(mesh, moved, *f, p.newton_steps, p.cell_size);
+        FoldGuard::Restore(mesh, moved, start);
+        return fitted;
+    }
+
+private:
+    /// Moves the vertices that share a face with a `moved` vertex, and are on no loop, to the
+    /// mean of their neighbours, `steps` times: marching cubes leaves thin faces at the
+    /// boundary, which a boundary vertex moving by a cell would fold over; its neighbours
+    /// follow instead. Appends them to `moved`, and their positions before, to `start`.
+    static void FollowMoves(CoreMesh& mesh, const std::vector<int>& uses, int steps, std::vector<int>& moved,
+                            std::vector<Eigen::Vector3d>& start)
+    {
+        std::vector<int> slot(mesh.vert.size(), -1);  // -2: a moved vertex; >= 0: in `ring`
+        for (int v : moved)
+            slot[size_t(v)] = -2;
+        std::vector<int> ring;
+        for (const CoreFace& face : mesh.face) {
+            const int a = int(vcg::tri::Index(mesh, face.cV(0))), b = int(vcg::tri::Index(mesh, face.cV(1))),
+                      c = int(vcg::tri::Index(mesh, face.cV(2)));
+            if (slot[size_t(a)] != -2 && slot[size_t(b)] != -2 && slot[size_t(c)] != -2)
+                continue;
+            for (int v : {a, b, c})
+                if (slot[size_t(v)] == -1 && uses[size_t(v)] == 0) {
+                    slot[size_t(v)] = int(ring.size());
+                    ring.push_back(v);
+                }
+        }
+        for (int v : ring) {
+            moved.push_back(v);
+            start.push_back(PositionOf(mesh, v));
+        }
+        std::vector<std::vector<int>> neighbours(ring.size());
+        for (const CoreFace& face : mesh.face)
+            for (int i = 0; i < 3; ++i)
+                if (const int s = slot[vcg::tri::Index(mesh, face.cV(i))]; s >= 0)
+                    for (int j = 1; j < 3; ++j)
+                        neighbours[size_t(s)].push_back(int(vcg::tri::Index(mesh, face.cV((i + j) % 3))));
+        std::vector<Eigen::Vector3d> next(ring.size());
+        for (int step = 0; step < steps; ++step) {
+            for (size_t i = 0; i < ring.size(); ++i) {
+                next[i].setZero();
+                for (int w : neighbours[i])
+                    next[i] += PositionOf(mesh, w);
+                next[i] /= double(neighbours[i].size());
+            }
+            for (size_t i = 0; i < ring.size(); ++i)
+                MoveVertex(mesh, ring[i], next[i]);
+        }
+    }
+
+    /// Area-weighted normals (from the faces' orientation) of the surface faces around each
+    /// vertex with uses[v] > 0; zero elsewhere.
+    static std::vector<Eigen::Vector3d> SurfaceNormals(const CoreMesh& mesh, const std::vector<char>& inSurface,
+                                                       const std::vector<int>& uses)
+    {
+        std::vector<Eigen::Vector3d> normal(mesh.vert.size(), Eigen::Vector3d::Zero());
+        for (size_t f = 0; f < mesh.face.size(); ++f) {
+            if (!inSurface[f])
+                continue;
+            const vcg::Point3d nf = vcg::TriangleNormal(mesh.face[f]);
+            for (int i = 0; i < 3; ++i)
+                if (const size_t v = vcg::tri::Index(mesh, mesh.face[f].cV(i)); uses[v] > 0)
+                    normal[v] += Eigen::Vector3d(nf[0], nf[1], nf[2]);
+        }
+        return normal;
+    }
+};
+
+} // namespace ib
