@@ -337,22 +337,44 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 	catch (const ib::InputError& e) {
 		throw MLException(QString("Implicit reconstruction with boundaries: ") + e.what());
 	}
+	catch (const ib::Cancelled&) {
+		throw MLException("Implicit reconstruction with boundaries was cancelled: nothing was added.");
+	}
 	catch (const std::bad_alloc&) {
 		throw MLException("Implicit reconstruction with boundaries ran out of memory: lower the resolution.");
 	}
+	catch (const std::exception& e) {
+		throw MLException(QString("Implicit reconstruction with boundaries failed (%1); nothing was added. "
+								  "Please report it with the input.").arg(e.what()));
+	}
 
-	MeshModel* out = md.addNewMesh("", input->label() + " with boundaries", true);
-	vcg::tri::Append<CMeshO, ib::CoreMesh>::MeshCopyConst(out->cm, surface);
-	vcg::tri::UpdateSelection<CMeshO>::VertexClear(out->cm);
-	for (const auto& loop : r.loops)
-		for (int v : loop.vertices)
-			out->cm.vert[v].SetS();
-	out->updateBoxAndNormals();
-	if (holeLayer) {
-		MeshModel* holeModel = md.addNewMesh("", input->label() + " holes", false);
-		vcg::tri::Append<CMeshO, ib::CoreMesh>::MeshCopyConst(holeModel->cm, holes);
-		holeModel->updateBoxAndNormals();
-		md.setCurrentMesh(out->id());
+	// Layers are added only now, and removed again if filling them fails (out of memory): an
+	// error never leaves a half-made layer in the user's document.
+	MeshModel* out = nullptr;
+	std::vector<unsigned int> added;
+	try {
+		out = md.addNewMesh("", input->label() + " with boundaries", true);
+		added.push_back(out->id());
+		vcg::tri::Append<CMeshO, ib::CoreMesh>::MeshCopyConst(out->cm, surface);
+		vcg::tri::UpdateSelection<CMeshO>::VertexClear(out->cm);
+		for (const auto& loop : r.loops)
+			for (int v : loop.vertices)
+				out->cm.vert[v].SetS();
+		out->updateBoxAndNormals();
+		if (holeLayer) {
+			MeshModel* holeModel = md.addNewMesh("", input->label() + " holes", false);
+			added.push_back(holeModel->id());
+			vcg::tri::Append<CMeshO, ib::CoreMesh>::MeshCopyConst(holeModel->cm, holes);
+			holeModel->updateBoxAndNormals();
+			md.setCurrentMesh(out->id());
+		}
+	}
+	catch (const std::bad_alloc&) {
+		for (unsigned int id : added)
+			md.delMesh(id);
+		md.setCurrentMesh(input->id());
+		throw MLException("Implicit reconstruction with boundaries ran out of memory while copying its result "
+						  "into a layer; nothing was added. Lower the resolution.");
 	}
 
 	std::vector<double> edges, lengths, loopVertices;

@@ -44,6 +44,37 @@ public:
     using std::runtime_error::runtime_error;
 };
 
+/// The progress callback returned false: the host asked to stop. Nothing is returned.
+class Cancelled : public std::runtime_error
+{
+public:
+    Cancelled() : std::runtime_error("cancelled") {}
+};
+
+/// Turns a callback's false ("stop") into a Cancelled exception, thrown from the call, so each
+/// stage stops at its next progress report without checking. Like ProgressRange, the target
+/// lives in thread-local state; stages report from the calling thread only (ParallelFor
+/// rethrows there once its threads are done).
+class Cancellation
+{
+public:
+    /// A callback forwarding to `target`, or null when target is null.
+    static vcg::CallBackPos* Watch(vcg::CallBackPos* target)
+    {
+        target_ = target;
+        return target ? &Forward : nullptr;
+    }
+
+private:
+    static bool Forward(const int pos, const char* what)
+    {
+        if (!target_(pos, what))
+            throw Cancelled();
+        return true;
+    }
+    static inline thread_local vcg::CallBackPos* target_ = nullptr;
+};
+
 /// Forwards a stage's own 0..100 progress into a range of the caller's callback. VCG's
 /// callback is a plain function pointer, so the range lives in thread-local state; stages
 /// report from the calling thread only.
@@ -163,9 +194,26 @@ public:
     /// P: n×3 samples; N: n×3 normals or empty (0 rows) when there are none.
     /// `surface` receives the extracted surface (vertices welded, faces along the normals);
     /// `holes`, when given, the hole triangles left open (surface + holes is closed where the
-    /// implicit surface is). Loop vertex indices refer to `surface`.
+    /// implicit surface is). Loop vertex indices refer to `surface`. Throws InputError on bad
+    /// input, Cancelled when cb returns false; then `surface` and `holes` are left empty.
     static Result Compute(const Points& input, const Points& inputNormals, const Param& p, CoreMesh& surface,
                           CoreMesh* holes = nullptr, vcg::CallBackPos* cb = nullptr)
+    {
+        try {
+            return Run(input, inputNormals, p, surface, holes, Cancellation::Watch(cb));
+        } catch (...) {
+            surface.Clear();
+            if (holes)
+                holes->Clear();
+            ReleaseFreedMemory();
+            throw;
+        }
+    }
+
+private:
+    /// Compute's body; cb already turns a false into Cancelled.
+    static Result Run(const Points& input, const Points& inputNormals, const Param& p, CoreMesh& surface,
+                      CoreMesh* holes, vcg::CallBackPos* cb)
     {
         using Clock = std::chrono::steady_clock;
         auto seconds = [](Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); };
@@ -260,6 +308,7 @@ public:
         return r;
     }
 
+public:
     /// The samples moved along their normals onto the implicit surface (one Newton step, f
     /// being close to a signed distance): the tangent disks are laid where the surface to be
     /// extracted is, not where the noisy or smoothed-over samples are. A fitted function (the

@@ -192,3 +192,62 @@ TEST(Reconstruction, RefusesRunsOverTheMemoryLimit)
     }
 }
 
+
+namespace {
+int g_calls = 0, g_allowed = 0;
+bool CountCalls(int, const char*)
+{
+    ++g_calls;
+    return true;
+}
+bool StopAfterAllowed(int, const char*)
+{
+    return g_allowed-- > 0;
+}
+} // namespace
+
+TEST(Reconstruction, CancelStopsAtEveryStageAndLeavesNothing)
+{
+    Points P, N;
+    test::SpherePoints(4000, 1.0, P, N, 0.0);  // a hemisphere: every stage, boundaries included, runs
+    for (auto implicit : {Reconstruction::Implicit::Hoppe, Reconstruction::Implicit::PuRbf}) {
+        Reconstruction::Param p;
+        p.implicit = implicit;
+        p.normals = Reconstruction::NormalSource::Estimate;  // the normals stage reports too
+        p.threads = 2;
+        CoreMesh m, h;
+        g_calls = 0;
+        Reconstruction::Compute(P, N, p, m, &h, &CountCalls);
+        const int total = g_calls;
+        ASSERT_GT(total, 5);
+        for (int k = 0; k < total; k += std::max(1, total / 10)) {
+            g_allowed = k;  // the callback says stop at its (k+1)-th call
+            CoreMesh surface, holes;
+            EXPECT_THROW(Reconstruction::Compute(P, N, p, surface, &holes, &StopAfterAllowed), Cancelled) << k;
+            EXPECT_TRUE(surface.vert.empty() && surface.face.empty() && holes.face.empty()) << k;
+        }
+        g_allowed = total;
+        CoreMesh again, holes;
+        const auto r = Reconstruction::Compute(P, N, p, again, &holes, &StopAfterAllowed);
+        EXPECT_EQ(r.loops.size(), 1u);
+        EXPECT_EQ(again.face.size(), m.face.size());
+    }
+}
+
+TEST(ParallelFor, RethrowsOnceEveryThreadHasFinished)
+{
+    std::vector<int> done(4, 0);
+    auto work = [&](size_t begin, size_t end, int thread) {
+        for (size_t i = begin; i < end; ++i)
+            done[size_t(thread)] += 1;
+        if (thread == 0 || thread == 2)
+            throw std::runtime_error("block " + std::to_string(thread));
+    };
+    try {
+        ParallelFor(4000, 4, work, 1000);
+        FAIL() << "no exception";
+    } catch (const std::runtime_error& e) {
+        EXPECT_STREQ(e.what(), "block 0");
+    }
+    EXPECT_EQ(done, (std::vector<int>{1000, 1000, 1000, 1000}));
+}
