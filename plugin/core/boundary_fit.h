@@ -6,8 +6,8 @@
 /// its outermost samples. For each boundary vertex v, with n the surface normal there, o is
 /// the direction in the tangent plane away from the centroid of the samples around v (out of
 /// the surface; it must agree with the loop's orientation). Among those samples that lie
-/// beside v (within a local spacing across o and off the surface), the outermost along o
-/// marks the edge; v moves along o onto it (plus `offset` local spacings), by at most
+/// beside v (within a local spacing across o and off the surface), the outermost along o on
+/// either side of v mark the edge, the line between them; v moves along o onto it (plus `offset` local spacings), by at most
 /// `max_move` spacings, and the vertices next to v follow (FollowMoves). All targets are computed before any vertex moves; moves that would
 /// fold a face are pulled back (fold_guard.h), after the moved vertices are put back on the
 /// implicit surface (the move is along its tangent plane, implicit_projection.h).
@@ -74,7 +74,11 @@ public:
                 if (!out.allFinite() || out.dot(along.cross(n)) <= 0)
                     continue;  // no clear side (a corner, a narrow strip): leave the vertex
                 const Eigen::Vector3d t = n.cross(out);
-                double edge = -std::numeric_limits<double>::infinity(), h = 0, nearest = std::numeric_limits<double>::infinity();
+                // The outermost sample on each side of v (along t, within a spacing); the edge
+                // at v is the line between them, as a mesh through the samples would run.
+                const double none = -std::numeric_limits<double>::infinity();
+                double h = 0, nearest = std::numeric_limits<double>::infinity();
+                Eigen::Vector2d side[2] = {{0, none}, {0, none}};  // (along t, along out)
                 for (int k = 0; k < found; ++k) {
                     const int s = queue.getIndex(k);
                     const Eigen::Vector3d d = samples.P().row(s).transpose() - q;
@@ -82,11 +86,17 @@ public:
                         nearest = queue.getWeight(k);
                         h = spacing[s];
                     }
-                    if (std::abs(d.dot(t)) <= spacing[s] && std::abs(d.dot(n)) <= spacing[s])
-                        edge = std::max(edge, d.dot(out));
+                    const double a = d.dot(t), o = d.dot(out);
+                    if (std::abs(a) <= spacing[s] && std::abs(d.dot(n)) <= spacing[s] && o > side[a >= 0][1])
+                        side[a >= 0] = {a, o};
                 }
-                if (!std::isfinite(edge) || !(h > 0))
+                if (!(h > 0) || (side[0][1] == none && side[1][1] == none))
                     continue;
+                const double edge = side[0][1] == none   ? side[1][1]
+                                    : side[1][1] == none ? side[0][1]
+                                    : side[1][0] - side[0][0] > 0
+                                        ? side[0][1] + (side[1][1] - side[0][1]) * -side[0][0] / (side[1][0] - side[0][0])
+                                        : std::max(side[0][1], side[1][1]);
                 const double step = std::clamp(edge + p.offset * h, -p.max_move * h, p.max_move * h);
                 moved.push_back(v);
                 start.push_back(q);
