@@ -108,20 +108,25 @@ def test_loops_are_exact_and_within_a_cell_of_the_true_boundary(name):
 
 
 def test_each_boundary_step_brings_the_boundary_closer():
-    """Measured on the punched sphere: the trim, the fit to the samples' edge and the smoothing
-    each lower the largest distance from the true rims (in cells)."""
+    """Measured on the punched sphere (distances of boundary vertices from the true rims, in
+    cells; largest, mean): no trim (4.09, 3.19), trim (1.33, 0.41), + smoothing (1.33, 0.26),
+    + fit (0.67, 0.09); the fit alone, unsmoothed (1.03, 0.13). Each step lowers the mean, and
+    the fit, last, the largest."""
     points, normals, curves = punched_sphere_case()
 
-    def worst(**params):
+    def error(**params):
         rec = implicit_boundaries.reconstruct(points, normals, min_boundary_edges=25, **params)
         truth = cKDTree(dense(curves, rec.info["cell_size"]))
-        return max(truth.query(rec.vertices[l])[0].max() for l in rec.loops) / rec.info["cell_size"]
+        d = np.concatenate([truth.query(rec.vertices[l])[0] for l in rec.loops]) / rec.info["cell_size"]
+        return d.max(), d.mean()
 
-    untrimmed = worst(boundary_trim=0, boundary_fit=False, boundary_smoothing=0)
-    trimmed = worst(boundary_fit=False, boundary_smoothing=0)
-    fitted = worst(boundary_smoothing=0)
-    smoothed = worst()
-    assert untrimmed > 2 > trimmed > fitted > smoothed
+    untrimmed = error(boundary_trim=0, boundary_fit=False, boundary_smoothing=0)
+    trimmed = error(boundary_fit=False, boundary_smoothing=0)
+    smoothed = error(boundary_fit=False)
+    fitted = error()
+    assert untrimmed[1] > 2 > trimmed[1] > smoothed[1] > fitted[1]
+    assert untrimmed[0] > trimmed[0] >= smoothed[0] > fitted[0]
+    assert fitted[0] < 1 < smoothed[0]
 
 
 def loops_at_holes(rec, centres, radii):

@@ -155,7 +155,8 @@ public:
         /// Faces at the boundary farther than this many local spacings from every sample are
         /// peeled off (the margin the SODS adds past the scan's edge). 0 = no trim.
         double boundary_trim = 0.25;
-        /// Move the boundary within the surface onto the edge of the samples (boundary_fit.h).
+        /// After smoothing, move the boundary within the surface onto the edge of the samples
+        /// (boundary_fit.h).
         bool boundary_fit = true;
         int boundary_smoothing = 4;  ///< iterations of collinearity moves (paper §3.3), 0 = off
         GatedMarchingCubes::Extraction extraction = GatedMarchingCubes::Extraction::SodsDriven;
@@ -349,9 +350,10 @@ public:
     }
 
     /// The boundary stage on the whole extraction `all` (surface faces first, then hole faces):
-    /// fills small holes, trims, removes pinches and scraps, fits the boundary to the samples'
-    /// edge, smooths. Returns which faces are
-    /// surface. Smoothing works on surface and hole faces alike, so the holes follow the boundary.
+    /// fills small holes, trims, removes pinches and scraps, smooths, fits the boundary to the
+    /// samples' edge (in that order: fitting last puts the straightened loop back on the scan's
+    /// edge, where the smoothing's corner cuts had moved it). Returns which faces are surface.
+    /// Smoothing and fit move surface and hole faces alike, so the holes follow the boundary.
     static std::vector<char> Boundaries(CoreMesh& all, const GatedMarchingCubes::Result& mc, const SampleIndex& samples,
                                         const Eigen::VectorXd& spacing, const ImplicitFunction& f, double cell,
                                         const Param& p, Result& r)
@@ -375,15 +377,15 @@ public:
             r.faces_trimmed += BoundaryTrim::RemoveScraps(
                 all, inSurface, std::max(kMinPieceFaces, size_t(p.min_boundary_edges * p.min_boundary_edges / 4)));
         const std::vector<BoundaryLoop> loops = BoundaryLoops::Compute(all, inSurface);
+        BoundarySmoothing::Param sp;
+        sp.iterations = p.boundary_smoothing;
+        sp.cell_size = cell;
+        BoundarySmoothing::Compute(all, loops, &f, sp);
         if (p.boundary_fit) {
             BoundaryFit::Param fp;
             fp.cell_size = cell;
             r.boundary_vertices_fitted = BoundaryFit::Compute(all, loops, inSurface, samples, spacing, &f, fp);
         }
-        BoundarySmoothing::Param sp;
-        sp.iterations = p.boundary_smoothing;
-        sp.cell_size = cell;
-        BoundarySmoothing::Compute(all, loops, &f, sp);
         return inSurface;
     }
 
