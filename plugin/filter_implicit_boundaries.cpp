@@ -8,8 +8,9 @@
 
 namespace {
 
-// Order matches ib::Reconstruction::NormalSource.
-const QStringList kNormalSources = {"Use layer normals", "Estimate"};
+// The first two match ib::Reconstruction::NormalSource; the third is Estimate with the viewpoint.
+const QStringList kNormalSources = {"Use layer normals", "Estimate", "Estimate, facing the viewpoint"};
+const int kNormalsFacingViewpoint = 2;
 // Order matches ib::Reconstruction::Occupancy.
 const QStringList kOccupancies = {"Tangent disks", "Sample cells (paper)"};
 // Order matches ib::Reconstruction::Implicit.
@@ -258,7 +259,15 @@ RichParameterList FilterImplicitBoundariesPlugin::reconstructionParameters(const
 		"Where the oriented normals that define inside and outside come from. 'Use layer normals' "
 		"takes the layer's own (a scan's normals are usually best) and estimates them only when "
 		"the layer has none (all zero); 'Estimate' always fits them (PCA over neighbours, "
-		"oriented by propagation). The log says when normals were estimated."));
+		"oriented by propagation); 'Estimate, facing the viewpoint' orients them towards the "
+		"viewpoint below, the scanner's position for a single range scan (propagation can flip "
+		"whole regions of a thin or sparse scan: the surface then comes out inside-out there, "
+		"with a seam of boundary where the flipped region meets the rest). The log says when "
+		"normals were estimated."));
+	par.addParam(RichPosition(
+		"viewpoint", Point3m(0, 0, 0), "Viewpoint",
+		"With 'Estimate, facing the viewpoint': the position the scan was taken from; every "
+		"estimated normal is turned to face it."));
 	par.addParam(RichEnum(
 		"extraction", int(d.extraction), kExtractions, "Extraction",
 		"'SODS-driven' evaluates the implicit function only at the corners of occupied cells "
@@ -304,7 +313,13 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 	ib::Reconstruction::Param p;
 	p.resolution = par.getInt("resolution");
 	p.sods_dilation = par.getInt("sods_dilation");
-	p.normals = ib::Reconstruction::NormalSource(par.getEnum("normals"));
+	const int normals = par.getEnum("normals");
+	p.normals = normals == kNormalsFacingViewpoint ? ib::Reconstruction::NormalSource::Estimate
+												   : ib::Reconstruction::NormalSource(normals);
+	if (normals == kNormalsFacingViewpoint) {
+		const Point3m v = par.getPoint3m("viewpoint");
+		p.viewpoint = Eigen::Vector3d(v[0], v[1], v[2]);
+	}
 	p.normal_neighbours = par.getInt("normal_neighbours");
 	p.min_boundary_edges = par.getInt("min_boundary_edges");
 	p.boundary_trim = par.getFloat("boundary_trim");
@@ -388,8 +403,12 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 		log("Ignored %zu vertices at the same position as another one.", r.duplicates_removed);
 	if (r.normals_estimated)
 		log("Input had no usable normals (or estimation was requested): estimated them from %d "
-			"neighbours and oriented them by propagation%s.",
-			p.normal_neighbours, r.normals_flipped ? " (flipped to point away from the centroid)" : "");
+			"neighbours and oriented them %s%s.",
+			p.normal_neighbours,
+			p.viewpoint ? qUtf8Printable(QString("towards the viewpoint (%1, %2, %3)")
+											 .arg((*p.viewpoint)[0]).arg((*p.viewpoint)[1]).arg((*p.viewpoint)[2]))
+						: "by propagation",
+			r.normals_flipped ? " (flipped to point away from the centroid)" : "");
 	log("Implicit function: %s, built in %.2f s.", qUtf8Printable(kImplicits[int(p.implicit)]), r.seconds_implicit);
 	log("Lattice %dx%dx%d, cell %g (resolution %d%s, sample spacing %g).",
 		r.lattice_cells[0], r.lattice_cells[1], r.lattice_cells[2], r.cell_size, r.resolution,

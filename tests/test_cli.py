@@ -146,3 +146,25 @@ def test_options_reach_the_filter(tmp_path, capsys, plugin):
     filled = capsys.readouterr().out
     count = lambda text: int(text.split(" boundary loops kept")[0].split()[-1])
     assert count(unfilled) > count(filled)
+
+
+def test_viewpoint_orients_the_estimated_normals(tmp_path, capsys, plugin):
+    """--viewpoint: normals estimated facing the scanner, so the faces turn with it."""
+    import numpy as np
+
+    from test_reconstruct import fibonacci_sphere
+    points, _ = fibonacci_sphere(4000)
+    src = tmp_path / "dome.ply"
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=points[points[:, 2] > 0.2]))
+    ms.save_current_mesh(str(src))
+    facing = []
+    for z in ("5", "-5"):
+        out = tmp_path / f"dome{z}.ply"
+        assert main(["reconstruct", str(src), "-o", str(out), "--viewpoint", "0", "0", z]) == 0
+        assert f"normals estimated, facing the viewpoint (0, 0, {z})" in capsys.readouterr().out
+        ms.load_new_mesh(str(out))
+        v, f = ms.current_mesh().vertex_matrix(), ms.current_mesh().face_matrix()
+        a, b, c = (v[f[:, i]] for i in range(3))
+        facing.append(np.mean(np.einsum("ij,ij->i", np.cross(b - a, c - a), a + b + c) > 0))
+    assert facing[0] > 0.999 and facing[1] < 0.001

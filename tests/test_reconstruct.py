@@ -52,3 +52,16 @@ def test_repeated_samples_are_ignored():
     assert rec.info["duplicates_removed"] == 4 * 3000
     assert rec.loops == []
     assert np.abs(np.linalg.norm(rec.vertices, axis=1) - 1).max() < 0.25 * rec.info["cell_size"]
+
+
+@pytest.mark.parametrize("above", [True, False])
+def test_estimated_normals_face_the_viewpoint(above):
+    """A dome scanned from above, without normals: with the scanner's position the estimated
+    normals face it, and the faces follow them (outward from above, inward from below)."""
+    points, _ = fibonacci_sphere(6000)
+    points = points[points[:, 2] > 0.2]
+    rec = implicit_boundaries.reconstruct(points, viewpoint=[0, 0, 5 if above else -5])
+    a, b, c = (rec.vertices[rec.faces[:, i]] for i in range(3))
+    radial = np.einsum("ij,ij->i", np.cross(b - a, c - a), a + b + c)
+    assert np.mean(radial > 0) > 0.999 if above else np.mean(radial > 0) < 0.001
+    assert len(rec.loops) == 1

@@ -65,6 +65,9 @@ def _filter_params(args) -> dict:
         params["sods_occupancy"] = "Sample cells (paper)"
     if args.estimate_normals:
         params["normals"] = "Estimate"
+    if args.viewpoint is not None:
+        params["normals"] = "Estimate, facing the viewpoint"
+        params["viewpoint"] = np.array(args.viewpoint, dtype=np.float64)
     return params
 
 
@@ -76,9 +79,13 @@ def _reconstruct(ms: pymeshlab.MeshSet, args) -> dict:
     return apply(ms, **params)
 
 
-def _report(result: dict, out: Path) -> None:
+def _report(result: dict, out: Path, viewpoint=None) -> None:
     loops = loops_from_result(result)
     sizes = ", ".join(str(len(loop)) for loop in loops) or "none"
+    if result["normals_estimated"]:
+        how = "oriented by propagation" if viewpoint is None else \
+            "facing the viewpoint (" + ", ".join(f"{x:g}" for x in viewpoint) + ")"
+        print(f"normals estimated, {how}")
     print(f"resolution {result['resolution']} (cell {result['cell_size']:.4g}), "
           f"{result['surface_faces']} faces")
     print(f"{len(loops)} boundary loops kept; edges per loop: {sizes}")
@@ -95,7 +102,7 @@ def cmd_reconstruct(args) -> int:
     out = Path(args.output)
     out.parent.mkdir(parents=True, exist_ok=True)
     ms.save_current_mesh(str(out))
-    _report(result, out.resolve())
+    _report(result, out.resolve(), args.viewpoint)
     return 0
 
 
@@ -154,6 +161,8 @@ def _parser() -> argparse.ArgumentParser:
         q.add_argument("--paper-occupancy", action="store_true",
                        help="SODS from the cells holding samples, as in the paper (use with --sods-dilation 1)")
         q.add_argument("--estimate-normals", action="store_true", help="ignore the input's normals")
+        q.add_argument("--viewpoint", type=float, nargs=3, metavar=("X", "Y", "Z"),
+                       help="estimate normals facing this scanner position (one range scan)")
 
     r = sub.add_parser("reconstruct", help="reconstruct a point cloud file into a mesh file")
     r.add_argument("input")

@@ -8,6 +8,7 @@ import pymeshlab
 from ._plugin import apply, load
 
 NORMALS = {False: "Use layer normals", True: "Estimate"}
+FACING_VIEWPOINT = "Estimate, facing the viewpoint"
 
 
 @dataclass
@@ -37,11 +38,12 @@ def loops_from_result(result: Dict[str, object]) -> List[np.ndarray]:
 
 
 def reconstruct(points, normals: Optional[np.ndarray] = None, estimate_normals: bool = False,
-                **params) -> Reconstruction:
+                viewpoint: Optional[np.ndarray] = None, **params) -> Reconstruction:
     """Reconstructs the surface with boundaries of the (n, 3) ``points``.
 
     normals: (n, 3) outward normals, or None to estimate them (as does estimate_normals=True
-    when normals are given). params: the filter's other parameters by their pymeshlab names,
+    when normals are given). viewpoint: (3,) the scanner's position: normals are estimated and
+    turned to face it (a single range scan), instead of oriented by propagation. params: the filter's other parameters by their pymeshlab names,
     e.g. resolution=128 (cells along the longest bounding-box side; 0, the default, chooses it
     from the sample spacing), sods_occupancy, sample_radius, sods_dilation, normal_neighbours;
     ``pymeshlab.print_filter_parameter_list(implicit_boundaries.FILTER_NAME)`` lists them.
@@ -58,6 +60,10 @@ def reconstruct(points, normals: Optional[np.ndarray] = None, estimate_normals: 
         mesh = pymeshlab.Mesh(vertex_matrix=points, v_normals_matrix=normals)
     ms = pymeshlab.MeshSet()
     ms.add_mesh(mesh, "points")
-    info = apply(ms, normals=NORMALS[bool(estimate_normals)], **params)
+    if viewpoint is not None:
+        params.update(normals=FACING_VIEWPOINT, viewpoint=np.asarray(viewpoint, dtype=np.float64).reshape(3))
+    else:
+        params["normals"] = NORMALS[bool(estimate_normals)]
+    info = apply(ms, **params)
     out = ms.current_mesh()
     return Reconstruction(out.vertex_matrix(), out.face_matrix(), loops_from_result(info), dict(info))
