@@ -12,6 +12,7 @@ other surface), as % of the bounding-box diagonal.
 """
 import argparse
 import json
+import os
 import resource
 import subprocess
 import sys
@@ -50,7 +51,9 @@ def one(case, data, method, resolution):
     ms.add_mesh(pymeshlab.Mesh(vertex_matrix=points, v_normals_matrix=normals), "points")
     t = time.perf_counter()
     if method == "screened Poisson":
-        ms.generate_surface_reconstruction_screened_poisson(depth=poisson_depth(resolution), threads=1)
+        # All cores, as our filter uses.
+        ms.generate_surface_reconstruction_screened_poisson(depth=poisson_depth(resolution),
+                                                            threads=os.cpu_count())
         info = {}
     else:
         info = implicit_boundaries.apply(ms, implicit=method, resolution=resolution)

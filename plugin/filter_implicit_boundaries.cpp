@@ -409,7 +409,8 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 											 .arg((*p.viewpoint)[0]).arg((*p.viewpoint)[1]).arg((*p.viewpoint)[2]))
 						: "by propagation",
 			r.normals_flipped ? " (flipped to point away from the centroid)" : "");
-	log("Implicit function: %s, built in %.2f s.", qUtf8Printable(kImplicits[int(p.implicit)]), r.seconds_implicit);
+	log("Implicit function: %s%s, built in %.2f s.", qUtf8Printable(kImplicits[int(p.implicit)]),
+		r.rbf_cells > 0 ? qUtf8Printable(QString(" (%1 local RBF fits)").arg(r.rbf_cells)) : "", r.seconds_implicit);
 	log("Lattice %dx%dx%d, cell %g (resolution %d%s, sample spacing %g).",
 		r.lattice_cells[0], r.lattice_cells[1], r.lattice_cells[2], r.cell_size, r.resolution,
 		r.resolution_automatic ? ", automatic" : "", r.sample_spacing);
@@ -445,6 +446,8 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 	res["resolution"] = r.resolution;
 	res["cell_size"] = double(r.cell_size);
 	res["sample_spacing"] = double(r.sample_spacing);
+	res["implicit"] = int(p.implicit);
+	res["rbf_cells"] = r.rbf_cells;
 	res["sods_cells"] = double(r.sods_cells);
 	res["implicit_evaluations"] = double(r.evaluations);
 	res["full_lattice_evaluations"] = double(r.lattice_corners);
