@@ -46,7 +46,7 @@ def one(case, data, method, resolution):
         truth = None
     else:
         points, normals, faces = load_case(data / case)
-        truth = (points.copy(), faces)
+        truth = (points.copy(), faces) if len(faces) else None  # gargoyle: points only
     ms = pymeshlab.MeshSet()
     ms.add_mesh(pymeshlab.Mesh(vertex_matrix=points, v_normals_matrix=normals), "points")
     t = time.perf_counter()
