@@ -7,10 +7,11 @@
 /// the direction in the tangent plane away from the centroid of the samples around v (out of
 /// the surface; it must agree with the loop's orientation). Among those samples that lie
 /// beside v (within a local spacing across o and off the surface), the outermost along o on
-/// either side of v mark the edge, the line between them; v moves along o onto it (plus `offset` local spacings), by at most
-/// `max_move` spacings, and the vertices next to v follow (FollowMoves). All targets are computed before any vertex moves; moves that would
-/// fold a face are pulled back (fold_guard.h), after the moved vertices are put back on the
-/// implicit surface (the move is along its tangent plane, implicit_projection.h).
+/// either side of v mark the edge, the line between them; v moves along o onto it (plus
+/// `offset` local spacings), by at most `max_move` spacings, and the vertices next to v follow
+/// (FollowMoves). All targets are computed before any vertex moves. The moved vertices are put
+/// back on the implicit surface (the move is along its tangent plane, implicit_projection.h),
+/// then moves that would fold a face are pulled back (fold_guard.h).
 
 #include "boundaries.h"
 #include "fold_guard.h"
