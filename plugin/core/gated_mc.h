@@ -28,6 +28,7 @@
 #include <vcg/complex/algorithms/create/marching_cubes.h>
 
 #include <array>
+#include <optional>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -72,42 +73,48 @@ public:
         CornerValues values(lattice, f);
         const std::vector<Index3> cells = sods.Cells();
         r.sods_cells = cells.size();
+        if (param.extraction == Extraction::SodsDriven) {
+            if (cb) cb(10, "Evaluating the implicit function at SODS corners");
+            values.Evaluate(cells);
+        } else {
+            values.EvaluateAll(cb);
+        }
+        // The hole cells are found before any triangle is made, so the mesh is reserved once
+        // for both: a vector outgrowing its reserve copies every face made so far (on a large
+        // run the peak memory of the whole filter).
+        std::optional<HoleSearch> search;
+        if (param.holes && param.extraction != Extraction::Plain) {
+            if (cb) cb(60, "Searching hole cells");
+            const size_t cap = param.max_hole_cells ? param.max_hole_cells : std::max<size_t>(cells.size(), 4096);
+            search.emplace(lattice, sods, values, cells, cap);
+        }
         if (param.extraction != Extraction::Plain) {
-            // Measured: about 1.5 faces and 0.75 vertices per SODS cell (with the hole faces);
-            // reserving spares the copies of a growing vector on large runs.
-            mesh.face.reserve(cells.size() * 8 / 5);
-            mesh.vert.reserve(cells.size() * 4 / 5);
+            // Measured: about 1.5 faces and 0.75 vertices per SODS cell (hole cells alike).
+            const size_t all = cells.size() + (search ? search->cells.size() : 0);
+            mesh.face.reserve(all * 8 / 5);
+            mesh.vert.reserve(all * 4 / 5);
         }
         Walker walker(lattice, mesh, values);
         vcg::tri::MarchingCubes<CoreMesh, Walker> mc(mesh, walker);
         mc.Initialize();
-        if (param.extraction == Extraction::SodsDriven) {
-            if (cb) cb(10, "Evaluating the implicit function at SODS corners");
-            values.Evaluate(cells);
+        if (param.extraction == Extraction::Plain)
+            ExtractAll(mc, lattice, cb);
+        else
             Extract(mc, cells, cb);
-        } else {
-            values.EvaluateAll(cb);
-            if (param.extraction == Extraction::FullLatticeGated)
-                Extract(mc, cells, cb);
-            else
-                ExtractAll(mc, lattice, cb);
-        }
         r.surface_faces = mesh.face.size();
         std::vector<Index3> crossed = cells;  // and the hole cells, which all are crossed
 
-        if (param.holes && param.extraction != Extraction::Plain) {
-            if (cb) cb(90, "Searching hole triangles");
-            const size_t cap = param.max_hole_cells ? param.max_hole_cells : std::max<size_t>(cells.size(), 4096);
-            HoleSearch search(lattice, sods, values, cells, cap);
-            r.hole_cells = search.cells.size();
-            r.hole_search_capped = search.capped;
-            r.region_closed = search.closed;
-            for (size_t i = 0; i < search.cells.size(); ++i) {
+        if (search) {
+            if (cb) cb(90, "Extracting hole triangles");
+            r.hole_cells = search->cells.size();
+            r.hole_search_capped = search->capped;
+            r.region_closed = search->closed;
+            for (size_t i = 0; i < search->cells.size(); ++i) {
                 const size_t before = mesh.face.size();
-                Process(mc, search.cells[i]);
-                r.face_region.insert(r.face_region.end(), mesh.face.size() - before, search.region[i]);
+                Process(mc, search->cells[i]);
+                r.face_region.insert(r.face_region.end(), mesh.face.size() - before, search->region[i]);
             }
-            crossed.insert(crossed.end(), search.cells.begin(), search.cells.end());
+            crossed.insert(crossed.end(), search->cells.begin(), search->cells.end());
         }
         r.crossed_corners = values.CornerCount(crossed, true);
         mc.Finalize();
