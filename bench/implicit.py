@@ -9,6 +9,7 @@ the chamfer distance on the parts both reconstruct (samples within 1% of the dia
 other surface), as % of the bounding-box diagonal.
 
     python bench/implicit.py [--data DIR] [--cases bun_zipper.ply ...] > results.md
+    python bench/implicit.py --cases bun_zipper.ply tum_rabbit.ply --chamfer 212 512
 """
 import argparse
 import json
@@ -66,6 +67,11 @@ def one(case, data, method, resolution):
         m = ms.current_mesh()
         diagonal = np.linalg.norm(points.max(0) - points.min(0))
         out["chamfer_pct"] = 100 * shared_chamfer(m.vertex_matrix(), m.face_matrix(), *truth, 0.01 * diagonal) / diagonal
+        # Where the distance is: at the scan's vertices, or between them on its triangles.
+        at_vertices = point_mesh_distance(truth[0][::5], m.vertex_matrix(), m.face_matrix())
+        on_triangles = point_mesh_distance(sample_surface(*truth, 20000, seed=1), m.vertex_matrix(), m.face_matrix())
+        out["median_at_scan_vertices_pct"] = 100 * np.median(at_vertices) / diagonal
+        out["median_on_scan_triangles_pct"] = 100 * np.median(on_triangles) / diagonal
     return out
 
 
@@ -81,12 +87,26 @@ def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--data", type=Path, default=DEFAULT_DATA)
     p.add_argument("--cases", nargs="+", default=["bun_zipper.ply", "tum_rabbit.ply", "gargoyle.ply", "synthetic 1M"])
+    p.add_argument("--chamfer", type=int, nargs="+", metavar="RESOLUTION",
+                   help="only the chamfer of each method on each case at these resolutions, and where it "
+                        "comes from (median distance at the scan's vertices and on its triangles)")
     p.add_argument("--one", nargs=3, metavar=("CASE", "METHOD", "RESOLUTION"), help=argparse.SUPPRESS)
     args = p.parse_args(argv)
     implicit_boundaries.load()
     if args.one:
         case, method, resolution = args.one
         print(json.dumps(one(case, args.data, method, int(resolution))))
+        return
+    if args.chamfer:
+        print("| input | method | resolution / depth | chamfer, shared parts (% diag) "
+              "| median at scan vertices | median on scan triangles |\n|---|---|---|---|---|---|")
+        for case in args.cases:
+            for resolution in args.chamfer:
+                for method in METHODS:
+                    r = child(case, args.data, method, resolution)
+                    size = f"depth {poisson_depth(resolution)}" if method == "screened Poisson" else f"{resolution}"
+                    print(f"| {case} | {method} | {size} | {r['chamfer_pct']:.4f} | {r['median_at_scan_vertices_pct']:.4f} "
+                          f"| {r['median_on_scan_triangles_pct']:.4f} |", flush=True)
         return
     print("| input | method | resolution / depth | fit (s) | extraction (s) | total (s) | / screened Poisson "
           "| peak memory (MB) | loops | chamfer, shared parts (% diag) |")
