@@ -88,6 +88,9 @@ SHAPES = {
     "open cylinder": (open_cylinder, 2, {}),
     "hemisphere": (hemisphere, 1, {}),
     "plane-cut torus": (cut_torus, 2, {}),
+    # Its rim is sampled more densely than its surface; the PU-RBF's boundary there once came out
+    # 1.2 cells inside the cut, where the fit's edge line ran through a sample inside the rim.
+    "plane-cut torus, PU-RBF": (cut_torus, 2, {"implicit": "PU-RBF (paper)"}),
     "two disjoint patches": (polar_caps, 2, {}),
     "sphere with 5 holes and 3 gaps": (punched_sphere_case, 5, {"min_boundary_edges": 25}),
 }
