@@ -33,11 +33,17 @@ DEFAULT_DATA = Path(__file__).resolve().parent.parent.parent / "shared" / "data"
 METHODS = ["PU-RBF (paper)", "Hoppe signed distance", "screened Poisson"]
 
 
-def shared_chamfer(vertices, faces, truth_vertices, truth_faces, tolerance, samples=20000):
-    """Chamfer distance restricted to what both surfaces cover: the mean of the two mean
-    sample-to-other-surface distances, each over the samples within `tolerance`."""
+def surface_distances(vertices, faces, truth_vertices, truth_faces, samples=20000):
+    """Distances from samples of the result to the true surface, and from samples of the true
+    surface (on its triangles, between its vertices) to the result."""
     to_truth = point_mesh_distance(sample_surface(vertices, faces, samples, seed=2), truth_vertices, truth_faces)
     to_result = point_mesh_distance(sample_surface(truth_vertices, truth_faces, samples, seed=1), vertices, faces)
+    return to_truth, to_result
+
+
+def shared_chamfer(to_truth, to_result, tolerance):
+    """Chamfer distance restricted to what both surfaces cover: the mean of the two mean
+    sample-to-other-surface distances, each over the samples within `tolerance`."""
     return 0.5 * (to_truth[to_truth <= tolerance].mean() + to_result[to_result <= tolerance].mean())
 
 
@@ -66,12 +72,12 @@ def one(case, data, method, resolution):
     if truth is not None:
         m = ms.current_mesh()
         diagonal = np.linalg.norm(points.max(0) - points.min(0))
-        out["chamfer_pct"] = 100 * shared_chamfer(m.vertex_matrix(), m.face_matrix(), *truth, 0.01 * diagonal) / diagonal
+        to_truth, to_result = surface_distances(m.vertex_matrix(), m.face_matrix(), *truth)
+        out["chamfer_pct"] = 100 * shared_chamfer(to_truth, to_result, 0.01 * diagonal) / diagonal
         # Where the distance is: at the scan's vertices, or between them on its triangles.
         at_vertices = point_mesh_distance(truth[0][::5], m.vertex_matrix(), m.face_matrix())
-        on_triangles = point_mesh_distance(sample_surface(*truth, 20000, seed=1), m.vertex_matrix(), m.face_matrix())
         out["median_at_scan_vertices_pct"] = 100 * np.median(at_vertices) / diagonal
-        out["median_on_scan_triangles_pct"] = 100 * np.median(on_triangles) / diagonal
+        out["median_on_scan_triangles_pct"] = 100 * np.median(to_result) / diagonal
     return out
 
 

@@ -45,52 +45,48 @@ def test_filter_makes_a_new_current_layer_with_loops_selected(plugin):
         assert result[f"seconds_{stage}"] >= 0
 
 
-def test_bunny_scan_keeps_its_real_holes(plugin):
-    """pymeshlab's bunny (5,051 vertices) has 5 holes at its base; 2 of them are narrow slits
-    about two sample spacings wide, which no occupancy test can tell from sampling gaps. At the
-    automatic resolution the other 3 must come out as loops at the right place, and no large
-    boundary may appear anywhere else."""
+def bunny_holes(**params):
+    """The filter on pymeshlab's bunny (5,051 vertices, 5 holes at its base): its result, the
+    edge counts of the loops found at each true hole {hole: [edges]}, and those of the loops far
+    from every true hole."""
     points, normals, faces = point_cloud(SAMPLES / "bunny10k_textured.obj")
     true_holes = boundary_vertex_sets(faces, len(points))
     assert len(true_holes) == 5
     ms = new_set(points, normals)
-    result = getattr(ms, FILTER)()
-    assert result["implicit"] == 1 and result["rbf_cells"] == 0  # Hoppe's distance, the default
+    result = getattr(ms, FILTER)(**params)
     out = ms.current_mesh().vertex_matrix()
     loops = implicit_boundaries.loops_from_result(result)
-    spacing = result["sample_spacing"]
-
-    matched = match_loops([points[h] for h in true_holes], [out[loop] for loop in loops], 2.5 * spacing)
+    matched = match_loops([points[h] for h in true_holes], [out[loop] for loop in loops], 2.5 * result["sample_spacing"])
     found = {k: [len(loops[i]) for i in ids] for k, ids in matched.items()}
-    spurious = set(range(len(loops))) - {i for ids in matched.values() for i in ids}
-    assert not spurious, f"loops of {[len(loops[i]) for i in spurious]} edges far from every real hole"
-    print(f"\nresolution {result['resolution']}: {len(loops)} loops, edges {[len(l) for l in loops]}; "
+    spurious = [len(loops[i]) for i in set(range(len(loops))) - {i for ids in matched.values() for i in ids}]
+    print(f"\n{params or 'defaults'}, resolution {result['resolution']}: loops {[len(l) for l in loops]}; "
           f"per true hole (edges -> loops found): {[(len(h), found.get(k, [])) for k, h in enumerate(true_holes)]}")
+    return result, found, spurious
+
+
+def test_bunny_scan_keeps_its_real_holes(plugin):
+    """2 of the bunny's 5 holes are narrow slits about two sample spacings wide, which no
+    occupancy test can tell from sampling gaps. At the automatic resolution the other 3 must
+    come out as loops at the right place, and no large boundary may appear anywhere else."""
+    result, found, spurious = bunny_holes()
+    assert result["implicit"] == 1 and result["rbf_cells"] == 0  # Hoppe's distance, the default
+    assert not spurious, f"loops of {spurious} edges far from every real hole"
     assert sum(max(v) >= 15 for v in found.values()) >= 3
     assert result["holes_filled"] > 0  # the undersampling gaps, filled by min_boundary_edges
 
 
 @pytest.mark.parametrize("implicit", ["PU-RBF (paper)", "Hoppe signed distance"])
 def test_implicit_is_chosen_by_name(plugin, implicit):
-    """Both implicit functions by name on pymeshlab's bunny: the result says which ran (and the
-    PU-RBF's local fits), real holes come out as loops of 15+ edges at their place (Hoppe: 3,
-    the test above; the PU-RBF: 2, plus a 12-edge loop in a slit), and no loop appears anywhere
-    else (the PU-RBF's regularisation was 1e-6 here once: its zero set bulged past the rim of an
-    ear and left a spurious loop there)."""
-    points, normals, faces = point_cloud(SAMPLES / "bunny10k_textured.obj")
-    true_holes = boundary_vertex_sets(faces, len(points))
-    ms = new_set(points, normals)
-    result = getattr(ms, FILTER)(implicit=implicit)
+    """Both implicit functions by name on the bunny: the result says which ran (and the PU-RBF's
+    local fits), real holes come out as loops of 15+ edges at their place (Hoppe: 3, the test
+    above; the PU-RBF: 2, plus a 12-edge loop in a slit), and no loop appears anywhere else (the
+    PU-RBF's regularisation was 1e-6 here once: its zero set bulged past the rim of an ear and
+    left a spurious loop there)."""
+    result, found, spurious = bunny_holes(implicit=implicit)
     rbf = implicit == "PU-RBF (paper)"
     assert result["implicit"] == (0 if rbf else 1)
     assert (result["rbf_cells"] > 10) == rbf and result["rbf_cells"] >= 0
-    out = ms.current_mesh().vertex_matrix()
-    loops = implicit_boundaries.loops_from_result(result)
-    matched = match_loops([points[h] for h in true_holes], [out[loop] for loop in loops], 2.5 * result["sample_spacing"])
-    found = {k: [len(loops[i]) for i in ids] for k, ids in matched.items()}
-    spurious = set(range(len(loops))) - {i for ids in matched.values() for i in ids}
-    print(f"\n{implicit}: loops {[len(l) for l in loops]}; per true hole: {found}")
-    assert not spurious, f"loops of {[len(loops[i]) for i in spurious]} edges far from every real hole"
+    assert not spurious, f"loops of {spurious} edges far from every real hole"
     assert sum(max(v) >= 15 for v in found.values()) >= 2
 
 

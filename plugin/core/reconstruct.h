@@ -145,8 +145,8 @@ public:
         NormalSource normals = NormalSource::LayerOrEstimate;
         int normal_neighbours = 10;  ///< k for normal estimation
         std::optional<Eigen::Vector3d> viewpoint;  ///< orient estimated normals towards it
-        /// Hoppe's distance by default: on sparse scans the PU-RBF's least-squares zero set
-        /// bulges past thin rims (pymeshlab's bunny: a spurious loop at an ear; README).
+        /// Hoppe's distance by default: with the PU-RBF a Möbius strip keeps 2 loops instead of
+        /// 1, and pymeshlab's sparse bunny shows 2 of its holes instead of 3 (README).
         Implicit implicit = Implicit::Hoppe;
         PuRbf::Param rbf;            ///< the PU-RBF's cells and fits (threads: taken from `threads`)
         int hoppe_neighbours = 8;    ///< tangent planes blended by the signed distance
