@@ -25,6 +25,7 @@ DEFAULT_DATA = Path(__file__).resolve().parent.parent.parent / "shared" / "data"
 CASES = ["bun_zipper.ply", "mech-holes-shark.off", "fandisk_truncated.off", "tum_rabbit.ply", "gargoyle.ply"]
 METHODS = {
     "ours (defaults)": {},
+    "ours, Hoppe's distance": {"implicit": "Hoppe signed distance"},
     "ours, no smoothing": {"boundary_smoothing": 0},
     "ours, no trim": {"boundary_trim": 0.0},
     "ours, no trim, no smoothing": {"boundary_trim": 0.0, "boundary_smoothing": 0},
@@ -105,11 +106,11 @@ def references(args):
             ours, _, found, spurious, distance = run(points, normals, truth, truth_curves, 0, {})
             rows = [("ours", ours["boundary_loops"], found, spurious, distance)]
             for method in ["screened Poisson", "screened Poisson + 5% density trim", "screened Poisson + our boundaries",
-                           "PU-RBF + our boundaries", "ball pivoting"]:
-                if method == "PU-RBF + our boundaries":
-                    pu, _, found, spurious, distance = run(points, normals, truth, truth_curves, 0,
-                                                           {"implicit": "PU-RBF (paper)"})
-                    rows.append((method, pu["boundary_loops"], found, spurious, distance))
+                           "Hoppe + our boundaries", "ball pivoting"]:
+                if method == "Hoppe + our boundaries":
+                    hoppe, _, found, spurious, distance = run(points, normals, truth, truth_curves, 0,
+                                                              {"implicit": "Hoppe signed distance"})
+                    rows.append((method, hoppe["boundary_loops"], found, spurious, distance))
                     continue
                 loops, found_curves, _ = reference_loops(method, points, normals, ours["resolution"])
                 found, spurious = loops_found(truth, loops, 2.5 * ours["sample_spacing"] + 2 * ours["cell_size"])

@@ -423,6 +423,11 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 		"boundary vertices fitted to the samples' edge.",
 		out->cm.fn, out->cm.vn, int(r.loops.size()), qUtf8Printable(loopSummary(r.loops)),
 		r.holes_filled, p.min_boundary_edges, r.faces_trimmed, r.boundary_vertices_fitted);
+	if (r.seam_points > 0)
+		log("The normals flip between neighbouring samples at %zu places (a one-sided surface, or a region "
+			"oriented inside out): cut the surface there (%zu faces) into a boundary. If that region should "
+			"not be cut, estimate normals facing the scanner's viewpoint.",
+			r.seam_points, r.faces_cut_at_seams);
 	log("%s extraction: %zu SODS cells, %zu hole cells%s; %zu implicit evaluations (the full "
 		"lattice has %.0f corners, the cells the surface crosses %zu).",
 		qUtf8Printable(kExtractions[int(p.extraction)]), r.sods_cells, r.hole_cells,
@@ -440,6 +445,8 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 	res["hole_cells"] = double(r.hole_cells);
 	res["faces_trimmed"] = double(r.faces_trimmed);
 	res["boundary_vertices_fitted"] = double(r.boundary_vertices_fitted);
+	res["seam_points"] = double(r.seam_points);
+	res["faces_cut_at_seams"] = double(r.faces_cut_at_seams);
 	res["duplicates_removed"] = double(r.duplicates_removed);
 	res["surface_faces"] = out->cm.fn;
 	res["surface_vertices"] = out->cm.vn;

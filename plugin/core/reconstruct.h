@@ -13,6 +13,7 @@
 #include "implicit/pu_rbf.h"
 #include "memory_budget.h"
 #include "normals.h"
+#include "orientation_seam.h"
 #include "pinches.h"
 #include "sods.h"
 #include "spacing.h"
@@ -120,6 +121,10 @@ public:
     /// the boundaries: measured on the Stanford bunny scan (bun_zipper, 34,834 samples), 0.6
     /// finds all 5 holes as single loops (1.0 merges the smallest into undersampling noise).
     static constexpr double kCellPerSpacing = 0.6;
+    /// Surface faces within this many median spacings of an orientation seam are cut away: the
+    /// walls a signed implicit function forms where the normals flip reach about 1.75 spacings
+    /// to either side (Möbius strip, both implicit functions).
+    static constexpr double kSeamRadius = 2.0;
     /// Pieces of surface with fewer faces left by the trim are removed (a few cells' worth).
     static constexpr size_t kMinPieceFaces = 10;
 
@@ -145,9 +150,7 @@ public:
         NormalSource normals = NormalSource::LayerOrEstimate;
         int normal_neighbours = 10;  ///< k for normal estimation
         std::optional<Eigen::Vector3d> viewpoint;  ///< orient estimated normals towards it
-        /// Hoppe's distance by default: with the PU-RBF a Möbius strip keeps 2 loops instead of
-        /// 1, and pymeshlab's sparse bunny shows 2 of its holes instead of 3 (README).
-        Implicit implicit = Implicit::Hoppe;
+        Implicit implicit = Implicit::PuRbf;
         PuRbf::Param rbf;            ///< the PU-RBF's cells and fits (threads: taken from `threads`)
         int hoppe_neighbours = 8;    ///< tangent planes blended by the signed distance
         const ImplicitFunction* given = nullptr;  ///< used with Implicit::Given; not owned
@@ -174,6 +177,8 @@ public:
         int holes_filled = 0;             ///< hole regions added to the surface
         size_t faces_trimmed = 0;         ///< unsupported faces peeled off the boundary
         size_t faces_unpinched = 0;       ///< faces of smaller fans removed at pinch vertices
+        size_t seam_points = 0;           ///< where neighbouring samples' normals flip (orientation_seam.h)
+        size_t faces_cut_at_seams = 0;    ///< surface faces removed around those points
         size_t boundary_vertices_fitted = 0;  ///< boundary vertices moved onto the samples' edge
         size_t duplicates_removed = 0;    ///< samples at the same position as an earlier one
         size_t hole_cells = 0;
@@ -299,7 +304,10 @@ private:
 
         t = Clock::now();
         if (cb) cb(97, "Tracing boundary loops, filling small holes");
-        const std::vector<char> inSurface = Boundaries(surface, mc, samples, spacing, f, lattice.cell_size, p, r);
+        const Points seam = OrientationSeam::Find(samples, normals, spacing, p.threads);
+        r.seam_points = size_t(seam.rows());
+        const std::vector<char> inSurface =
+            Boundaries(surface, mc, samples, spacing, seam, f, lattice.cell_size, p, r);
         if (holes)
             Split(surface, inSurface, 0, *holes);
         KeepSurface(surface, inSurface);
@@ -360,8 +368,8 @@ public:
     /// edge, where the smoothing's corner cuts had moved it). Returns which faces are surface.
     /// Smoothing and fit move surface and hole faces alike, so the holes follow the boundary.
     static std::vector<char> Boundaries(CoreMesh& all, const GatedMarchingCubes::Result& mc, const SampleIndex& samples,
-                                        const Eigen::VectorXd& spacing, const ImplicitFunction& f, double cell,
-                                        const Param& p, Result& r)
+                                        const Eigen::VectorXd& spacing, const Points& seam,
+                                        const ImplicitFunction& f, double cell, const Param& p, Result& r)
     {
         std::vector<char> inSurface(all.face.size(), 0);
         std::fill(inSurface.begin(), inSurface.begin() + long(mc.surface_faces), 1);
@@ -373,6 +381,9 @@ public:
             if (fill[size_t(mc.face_region[face - mc.surface_faces])])
                 inSurface[face] = 1;
         r.holes_filled = int(std::count(fill.begin(), fill.end(), 1));
+        // After the filling, so that the cut is not taken for a small hole and closed again.
+        r.faces_cut_at_seams =
+            OrientationSeam::Cut(all, seam, kSeamRadius * r.sample_spacing, inSurface, p.threads);
         if (p.boundary_trim > 0)
             r.faces_trimmed = BoundaryTrim::Compute(all, samples, p.boundary_trim * spacing, inSurface, p.threads);
         r.faces_unpinched = Pinches::Resolve(all, inSurface);

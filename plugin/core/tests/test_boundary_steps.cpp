@@ -2,6 +2,7 @@
 #include "boundary_trim.h"
 #include "fold_guard.h"
 #include "geometry.h"
+#include "orientation_seam.h"
 #include "pinches.h"
 #include "reconstruct.h"
 
@@ -69,6 +70,43 @@ TEST(BoundarySteps, FlatScanIsTrimmedToItsBorderAndSmoothed)
     EXPECT_EQ(t.non_manifold_edges, 0);
     EXPECT_EQ(t.non_manifold_vertices, 0);
     EXPECT_TRUE(t.oriented);
+}
+
+TEST(BoundarySteps, FlippedNormalsAreCutAlongTheFlip)
+{
+    // The flat scan with the normals of its half x > 0.5 turned down: the seam is the line
+    // x = 0.5, and the surface is cut there into two pieces with one loop each.
+    Points P, N;
+    FlatScan(0.02, P, N);
+    for (Eigen::Index i = 0; i < P.rows(); ++i)
+        if (P(i, 0) > 0.5)
+            N(i, 2) = -1;
+    const SampleIndex samples(P);
+    const Points seam = OrientationSeam::Find(samples, N, SampleSpacing::Local(samples));
+    ASSERT_GT(seam.rows(), 40);  // pairs across the line, all along it
+    EXPECT_LT((seam.col(0).array() - 0.5).abs().maxCoeff(), 0.02);
+    EXPECT_LT(seam.col(1).minCoeff(), 0.05);
+    EXPECT_GT(seam.col(1).maxCoeff(), 0.95);
+    CoreMesh m;
+    const auto r = Reconstruction::Compute(P, N, Reconstruction::Param(), m);
+    EXPECT_EQ(r.seam_points, size_t(seam.rows()));
+    EXPECT_GT(r.faces_cut_at_seams, 0u);
+    ASSERT_EQ(r.loops.size(), 2u);
+    for (const auto& v : m.vert)  // nothing left within a spacing of the seam
+        EXPECT_GT(std::abs(v.cP()[0] - 0.5), 0.02);
+    const auto t = test::Check(m);
+    EXPECT_EQ(t.non_manifold_edges, 0);
+    EXPECT_TRUE(t.oriented);
+
+    // Upside down but consistent, or the two sides of a thin plate: no seam.
+    N.col(2).setConstant(-1);
+    EXPECT_EQ(OrientationSeam::Find(samples, N, SampleSpacing::Local(samples)).rows(), 0);
+    Points plate(2 * P.rows(), 3), sides(2 * P.rows(), 3);
+    plate << P, P.rowwise() + Eigen::RowVector3d(0.01, 0, -0.01);
+    sides << Points::Zero(P.rows(), 3).rowwise() + Eigen::RowVector3d(0, 0, 1),
+        Points::Zero(P.rows(), 3).rowwise() + Eigen::RowVector3d(0, 0, -1);
+    const SampleIndex plateSamples(plate);
+    EXPECT_EQ(OrientationSeam::Find(plateSamples, sides, SampleSpacing::Local(plateSamples)).rows(), 0);
 }
 
 TEST(BoundarySteps, PinchKeepsTheLargerFan)

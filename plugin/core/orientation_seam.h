@@ -1,0 +1,103 @@
+#pragma once
+/// \file orientation_seam.h
+/// Orientation seams: where neighbouring samples lie in each other's tangent plane but their
+/// normals point to opposite sides, the normals have flipped along the surface (a one-sided
+/// surface such as a Möbius strip, or a region that normal propagation turned inside out). No
+/// signed implicit function can follow such a flip: its zero set there forms walls across the
+/// surface that join it in knots (handles, extra loops), differently for every implicit. The
+/// seam is cut instead: surface faces near a seam point are moved into the holes, leaving one
+/// clean boundary across the surface.
+/// Opposite normals across a thin part (the two sides of a plate) are not a seam: there each
+/// sample lies off the other's tangent plane by the part's thickness.
+
+#include "mesh.h"
+#include "parallel.h"
+#include "samples.h"
+
+#include <cmath>
+#include <vector>
+
+namespace ib {
+
+class OrientationSeam
+{
+public:
+    /// Normals at more than 120 degrees to each other disagree.
+    static constexpr double kOpposite = -0.5;
+    /// Neighbours within this many local spacings are compared.
+    static constexpr double kNeighbourhood = 1.5;
+    /// A neighbour within this many local spacings of the other's tangent plane lies in it
+    /// (plates thinner than that are below what the samples resolve).
+    static constexpr double kInPlane = 0.25;
+
+    /// Seam points: the midpoints of the neighbouring pairs (i, j), i < j, of samples whose unit
+    /// normals N (n×3) disagree while each lies in the other's tangent plane. spacing: per
+    /// sample, its local spacing. Returns m×3 points, m = 0 for consistently oriented samples.
+    static Points Find(const SampleIndex& samples, const Points& N, const Eigen::VectorXd& spacing, int threads = 0)
+    {
+        const Points& P = samples.P();
+        const int k = std::min<int>(8, int(P.rows()) - 1);
+        // Per sample, its seam partners of higher index: the order of the points does not
+        // depend on the thread count.
+        std::vector<std::vector<Eigen::Index>> partners(size_t(P.rows()));
+        ParallelFor(size_t(P.rows()), threads, [&](size_t begin, size_t end, int) {
+            SampleIndex::Queue queue;
+            for (size_t i = begin; i < end; ++i) {
+                const Eigen::Index a = Eigen::Index(i);
+                samples.Nearest(P.row(a).transpose(), k + 1, queue);
+                for (int q = 0; q < queue.getNofElements(); ++q) {
+                    const Eigen::Index b = queue.getIndex(q);
+                    if (b > a && Disagree(P, N, a, b, spacing[a]))
+                        partners[i].push_back(b);
+                }
+            }
+        }, 256);
+        std::vector<Eigen::Vector3d> mid;
+        for (Eigen::Index a = 0; a < P.rows(); ++a)
+            for (Eigen::Index b : partners[size_t(a)])
+                mid.push_back(0.5 * (P.row(a) + P.row(b)).transpose());
+        Points out(Eigen::Index(mid.size()), 3);
+        for (size_t i = 0; i < mid.size(); ++i)
+            out.row(Eigen::Index(i)) = mid[i].transpose();
+        return out;
+    }
+
+    /// Among the faces f of `mesh` with inSurface[f], removes (sets to 0) those whose centroid
+    /// lies within `radius` of a seam point (rows of `seam`). Returns the number removed.
+    static size_t Cut(const CoreMesh& mesh, const Points& seam, double radius, std::vector<char>& inSurface,
+                      int threads = 0)
+    {
+        if (seam.rows() == 0)
+            return 0;
+        const SampleIndex index(seam);
+        std::vector<char> cut(mesh.face.size(), 0);
+        ParallelFor(mesh.face.size(), threads, [&](size_t begin, size_t end, int) {
+            SampleIndex::Queue queue;
+            for (size_t f = begin; f < end; ++f) {
+                if (!inSurface[f])
+                    continue;
+                const vcg::Point3d c = vcg::Barycenter(mesh.face[f]);
+                index.Nearest(Eigen::Vector3d(c[0], c[1], c[2]), 1, queue);
+                cut[f] = queue.getWeight(0) < radius * radius;
+            }
+        });
+        size_t removed = 0;
+        for (size_t f = 0; f < cut.size(); ++f)
+            if (cut[f]) {
+                inSurface[f] = 0;
+                ++removed;
+            }
+        return removed;
+    }
+
+private:
+    static bool Disagree(const Points& P, const Points& N, Eigen::Index a, Eigen::Index b, double spacing)
+    {
+        const Eigen::Vector3d d = (P.row(b) - P.row(a)).transpose();
+        const Eigen::Vector3d na = N.row(a).transpose(), nb = N.row(b).transpose();
+        return na.dot(nb) < kOpposite && d.norm() <= kNeighbourhood * spacing &&
+               std::abs(d.dot(na)) < kInPlane * spacing && std::abs(d.dot(nb)) < kInPlane * spacing;
+    }
+};
+
+} // namespace ib
