@@ -56,7 +56,7 @@ def load(case, data):
     return points, normals
 
 
-def one(case, data, resolution, mode):
+def one(case, data, resolution, mode, implicit):
     """Runs one filter call in this process; returns its figures (peak memory of the process)."""
     points, normals = load(case, data)
     ms = pymeshlab.MeshSet()
@@ -64,7 +64,7 @@ def one(case, data, resolution, mode):
     del points, normals
     before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
     t = time.perf_counter()
-    out = implicit_boundaries.apply(ms, resolution=resolution, extraction=mode)
+    out = implicit_boundaries.apply(ms, resolution=resolution, extraction=mode, implicit=implicit)
     seconds = time.perf_counter() - t
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
     return {"seconds": seconds, "peak_mb": peak / 1024, "before_mb": before / 1024,
@@ -74,8 +74,8 @@ def one(case, data, resolution, mode):
                                           "memory_limit_gb"]}}
 
 
-def child(case, data, resolution, mode):
-    cmd = [sys.executable, __file__, "--one", case, str(resolution), mode, "--data", str(data)]
+def child(case, data, resolution, mode, implicit):
+    cmd = [sys.executable, __file__, "--one", case, str(resolution), mode, "--data", str(data), "--implicit", implicit]
     done = subprocess.run(cmd, capture_output=True, text=True)
     if done.returncode != 0:
         return {"error": done.stderr.strip().splitlines()[-1] if done.stderr.strip() else "failed"}
@@ -90,6 +90,7 @@ def main(argv=None):
     p.add_argument("--modes", nargs="+", choices=MODES, default=MODES,
                    help="extraction modes to run (the full lattice on the synthetic sphere is slow: its "
                         "centre is the k-d tree's worst case)")
+    p.add_argument("--implicit", default="PU-RBF (paper)", help="the filter's implicit function (default: its default)")
     p.add_argument("--large", action="store_true",
                    help="only a synthetic 5,000,000-sample scan at the default (automatic) resolution")
     p.add_argument("--one", nargs=3, metavar=("CASE", "RESOLUTION", "MODE"), help=argparse.SUPPRESS)
@@ -97,10 +98,10 @@ def main(argv=None):
     implicit_boundaries.load()
     if args.one:
         case, resolution, mode = args.one
-        print(json.dumps(one(case, args.data, int(resolution), mode)))
+        print(json.dumps(one(case, args.data, int(resolution), mode, args.implicit)))
         return
     if args.large:
-        r = child("synthetic 5M", args.data, 0, "SODS-driven")
+        r = child("synthetic 5M", args.data, 0, "SODS-driven", args.implicit)
         print("| samples | resolution | time (s) | implicit / SODS / extraction / boundaries (s) | peak memory (GB) "
               "| memory limit (GB) | SODS cells | faces | loops |\n|---|---|---|---|---|---|---|---|---|")
         print(f"| 5,000,000 | {r['resolution']:.0f} (automatic) | {r['seconds']:.1f} | {r['seconds_implicit']:.1f} / "
@@ -114,7 +115,7 @@ def main(argv=None):
     print("|---|---|---|---|---|---|---|---|---|---|---|---|")
     for case in args.cases:
         for resolution in args.resolutions:
-            rows = {mode: child(case, args.data, resolution, mode) for mode in args.modes}
+            rows = {mode: child(case, args.data, resolution, mode, args.implicit) for mode in args.modes}
             missing = {"error": "not run"}
             full, plain = rows.get("Full lattice, gated", missing), rows.get("Plain marching cubes", missing)
             for mode, r in rows.items():
@@ -129,7 +130,7 @@ def main(argv=None):
                       f"| {r['seconds_extraction']:.2f} "
                       f"| {r['peak_mb']:.0f} (input {r['before_mb']:.0f}) | {r['surface_faces']:.0f} "
                       f"| {r['boundary_loops']:.0f} | {vs_full} | {vs_plain} |", flush=True)
-    r = child("synthetic 1M", args.data, 1024, "SODS-driven")
+    r = child("synthetic 1M", args.data, 1024, "SODS-driven", args.implicit)
     print(f"\nSODS-driven at 1024 on the synthetic 1M scan: {r}")
 
 
