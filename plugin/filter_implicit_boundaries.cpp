@@ -403,12 +403,12 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 		log("Ignored %zu vertices at the same position as another one.", r.duplicates_removed);
 	if (r.normals_estimated)
 		log("Input had no usable normals (or estimation was requested): estimated them from %d "
-			"neighbours and oriented them %s%s.",
+			"neighbours and oriented them %s%s; %zu turned to agree with their neighbours.",
 			p.normal_neighbours,
 			p.viewpoint ? qUtf8Printable(QString("towards the viewpoint (%1, %2, %3)")
 											 .arg((*p.viewpoint)[0]).arg((*p.viewpoint)[1]).arg((*p.viewpoint)[2]))
 						: "by propagation",
-			r.normals_flipped ? " (flipped to point away from the centroid)" : "");
+			r.normals_flipped ? " (flipped to point away from the centroid)" : "", r.normals_turned);
 	log("Implicit function: %s%s, built in %.2f s.", qUtf8Printable(kImplicits[int(p.implicit)]),
 		r.rbf_cells > 0 ? qUtf8Printable(QString(" (%1 local RBF fits)").arg(r.rbf_cells)) : "", r.seconds_implicit);
 	log("Lattice %dx%dx%d, cell %g (resolution %d%s, sample spacing %g).",
@@ -461,6 +461,7 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 	res["crossed_cell_corners"] = double(r.crossed_corners);
 	res["memory_limit_gb"] = r.memory_limit / 1e9;
 	res["normals_estimated"] = r.normals_estimated;
+	res["normals_turned"] = int(r.normals_turned);
 	res["seconds_normals"] = r.seconds_normals;
 	res["seconds_implicit"] = r.seconds_implicit;
 	res["seconds_sods"] = r.seconds_sods;

@@ -2,9 +2,12 @@
 /// \file normals.h
 /// Normals for point sets that come without them: PCA planes over k neighbours, oriented
 /// consistently by VCGlib (vcg::tri::PointCloudNormal: Hoppe et al. 1992's propagation over
-/// the neighbour graph, or towards a viewpoint when one is given).
+/// the neighbour graph, or towards a viewpoint when one is given), then a neighbour vote
+/// that turns the few normals the propagation got wrong.
 
 #include "lattice.h"
+#include "parallel.h"
+#include "samples.h"
 
 #include <vcg/complex/complex.h>
 #include <vcg/complex/algorithms/pointcloud_normal.h>
@@ -34,13 +37,20 @@ public:
         int neighbours = 10;                      ///< k of the PCA fit and of the propagation
         int smoothing_iterations = 0;             ///< neighbour averaging passes after the fit
         std::optional<Eigen::Vector3d> viewpoint; ///< scanner position: normals face it
+        int threads = 0;                          ///< for the neighbour vote; 0 = all cores
+    };
+
+    /// What Compute did beyond the PCA fit.
+    struct Report
+    {
+        bool flipped = false;   ///< the whole set was turned to point away from the centroid
+        size_t turned = 0;      ///< normals turned by the neighbour vote
     };
 
     /// n×3 unit normals of the n×3 samples P. Without a viewpoint, propagation fixes the
     /// orientation only up to one global flip per connected neighbour graph; we flip the whole
     /// set so that most normals point away from the centroid (right for a scan of one object).
-    /// Returns whether that global flip was applied through `flipped`.
-    static Points Compute(const Points& P, const Param& p, bool* flipped = nullptr)
+    static Points Compute(const Points& P, const Param& p, Report* report = nullptr)
     {
         PointCloud m;
         auto vi = vcg::tri::Allocator<PointCloud>::AddVertices(m, size_t(P.rows()));
@@ -63,6 +73,7 @@ public:
             n.Normalize();
             N.row(i) << n[0], n[1], n[2];
         }
+        const size_t turned = TurnOutvoted(P, p.neighbours, p.threads, N);
         bool flip = false;
         if (!p.viewpoint) {
             const Eigen::RowVector3d centroid = P.colwise().mean();
@@ -70,9 +81,45 @@ public:
             if (flip)
                 N = -N;
         }
-        if (flipped)
-            *flipped = flip;
+        if (report)
+            *report = Report{flip, turned};
         return N;
+    }
+
+private:
+    /// Propagation (and a viewpoint at grazing angles) passes a wrong orientation on through a
+    /// noisy normal now and then: an isolated sample or a small group then faces the other way
+    /// and bends the implicit function into a dimple (a torus with 0.5%-diagonal noise: 1 of
+    /// 23,130 normals). A normal is turned when its k nearest neighbours clearly disagree:
+    /// the sum of their dot products with it is below -k/2. Decided from the normals as they
+    /// were (one pass, independent of the order and of the thread count); a real fold, where
+    /// the surface's two sides meet, has neighbours on both sides and is left alone.
+    static size_t TurnOutvoted(const Points& P, int k, int threads, Points& N)
+    {
+        if (P.rows() <= k)
+            return 0;
+        const SampleIndex index(P);
+        std::vector<char> turn(size_t(P.rows()), 0);
+        ParallelFor(size_t(P.rows()), threads, [&](size_t begin, size_t end, int) {
+            SampleIndex::Queue queue;
+            for (size_t i = begin; i < end; ++i) {
+                index.Nearest(P.row(Eigen::Index(i)).transpose(), k + 1, queue);  // +1: itself
+                double agreement = 0;
+                for (int q = 0; q < queue.getNofElements(); ++q) {
+                    const Eigen::Index j = queue.getIndex(q);
+                    if (j != Eigen::Index(i))
+                        agreement += N.row(j).dot(N.row(Eigen::Index(i)));
+                }
+                turn[i] = agreement < -0.5 * k;
+            }
+        });
+        size_t turned = 0;
+        for (Eigen::Index i = 0; i < P.rows(); ++i)
+            if (turn[size_t(i)]) {
+                N.row(i) = -N.row(i);
+                ++turned;
+            }
+        return turned;
     }
 };
 

@@ -196,6 +196,7 @@ public:
         double memory_limit = 0;     ///< the budget used, bytes
         bool normals_estimated = false;
         bool normals_flipped = false;
+        size_t normals_turned = 0;        ///< estimated normals turned to agree with their neighbours
         double seconds_normals = 0, seconds_implicit = 0, seconds_sods = 0, seconds_extraction = 0,
                seconds_boundaries = 0;
     };
@@ -358,8 +359,13 @@ public:
         PointNormals::Param np;
         np.neighbours = p.normal_neighbours;
         np.viewpoint = p.viewpoint;
+        np.threads = p.threads;
         r.normals_estimated = true;
-        return PointNormals::Compute(P, np, &r.normals_flipped);
+        PointNormals::Report report;
+        Points normals = PointNormals::Compute(P, np, &report);
+        r.normals_flipped = report.flipped;
+        r.normals_turned = report.turned;
+        return normals;
     }
 
     /// The boundary stage on the whole extraction `all` (surface faces first, then hole faces):
