@@ -47,11 +47,13 @@ public:
         size_t turned = 0;      ///< normals turned by the neighbour vote
     };
 
-    /// n×3 unit normals of the n×3 samples P. Without a viewpoint, propagation fixes the
-    /// orientation only up to one global flip per connected neighbour graph; we flip the whole
-    /// set so that most normals point away from the centroid (right for a scan of one object).
-    static Points Compute(const Points& P, const Param& p, Report* report = nullptr)
+    /// n×3 unit normals of the n×3 samples samples.P(). Without a viewpoint, propagation fixes
+    /// the orientation only up to one global flip per connected neighbour graph; we flip the
+    /// whole set so that most normals point away from the centroid (right for a scan of one
+    /// object).
+    static Points Compute(const SampleIndex& samples, const Param& p, Report* report = nullptr)
     {
+        const Points& P = samples.P();
         PointCloud m;
         auto vi = vcg::tri::Allocator<PointCloud>::AddVertices(m, size_t(P.rows()));
         for (Eigen::Index i = 0; i < P.rows(); ++i, ++vi)
@@ -73,7 +75,7 @@ public:
             n.Normalize();
             N.row(i) << n[0], n[1], n[2];
         }
-        const size_t turned = TurnOutvoted(P, p.neighbours, p.threads, N);
+        const size_t turned = TurnOutvoted(samples, p.neighbours, p.threads, N);
         bool flip = false;
         if (!p.viewpoint) {
             const Eigen::RowVector3d centroid = P.colwise().mean();
@@ -94,11 +96,11 @@ private:
     /// the sum of their dot products with it is below -k/2. Decided from the normals as they
     /// were (one pass, independent of the order and of the thread count); a real fold, where
     /// the surface's two sides meet, has neighbours on both sides and is left alone.
-    static size_t TurnOutvoted(const Points& P, int k, int threads, Points& N)
+    static size_t TurnOutvoted(const SampleIndex& index, int k, int threads, Points& N)
     {
+        const Points& P = index.P();
         if (P.rows() <= k)
             return 0;
-        const SampleIndex index(P);
         std::vector<char> turn(size_t(P.rows()), 0);
         ParallelFor(size_t(P.rows()), threads, [&](size_t begin, size_t end, int) {
             SampleIndex::Queue queue;

@@ -240,12 +240,12 @@ private:
                              std::to_string(kMinPoints) + " are needed to fit tangent planes.");
 
         auto t = Clock::now();
-        const Points normals = OrientedNormals(P, N, p, r, cb);
+        const SampleIndex samples(P);  // the k-d tree every stage shares, from normals to the trim
+        const Points normals = OrientedNormals(samples, N, p, r, cb);
         r.seconds_normals = seconds(t);
 
         t = Clock::now();
         if (cb) cb(5, "Building the implicit function");
-        const SampleIndex samples(P);
         const Eigen::VectorXd spacing = SampleSpacing::Local(samples, 1, p.threads);
         r.sample_spacing = SampleSpacing::Median(spacing);
         const std::unique_ptr<ImplicitFunction> fitted =
@@ -351,7 +351,8 @@ public:
     }
 
     /// Unit normals: the layer's, or estimated ones (and says so in r).
-    static Points OrientedNormals(const Points& P, const Points& N, const Param& p, Result& r, vcg::CallBackPos* cb)
+    static Points OrientedNormals(const SampleIndex& samples, const Points& N, const Param& p, Result& r,
+                                  vcg::CallBackPos* cb)
     {
         if (p.normals == NormalSource::LayerOrEstimate && HasNormals(N))
             return N.rowwise().normalized();
@@ -362,7 +363,7 @@ public:
         np.threads = p.threads;
         r.normals_estimated = true;
         PointNormals::Report report;
-        Points normals = PointNormals::Compute(P, np, &report);
+        Points normals = PointNormals::Compute(samples, np, &report);
         r.normals_flipped = report.flipped;
         r.normals_turned = report.turned;
         return normals;

@@ -197,7 +197,7 @@ Accuracy FitAndMeasure(const Analytic& c, const Points& N, const char* what)
 /// oriented by propagation, then the neighbour vote).
 Points Estimated(const Points& P, PointNormals::Report* report = nullptr)
 {
-    return PointNormals::Compute(P, PointNormals::Param{}, report);
+    return PointNormals::Compute(SampleIndex(P), PointNormals::Param{}, report);
 }
 
 /// Cosines between estimated normals E and exact ones N, row by row.
