@@ -40,7 +40,12 @@ METHODS = {
                                       "rbf_off_surface": 0.5},
     "Hoppe signed distance": {"implicit": "Hoppe signed distance"},
     "screened Poisson": None,
+    # Variants of the paper's 50-160 samples per cell, run with --methods.
+    "PU-RBF, off-surface 0.5": {"implicit": "PU-RBF (paper)", "rbf_off_surface": 0.5},
+    "PU-RBF, overlap 1.2": {"implicit": "PU-RBF (paper)", "rbf_overlap": 1.2},
+    "PU-RBF, overlap 1.2, off-surface 0.5": {"implicit": "PU-RBF (paper)", "rbf_overlap": 1.2, "rbf_off_surface": 0.5},
 }
+DEFAULT_METHODS = ["PU-RBF (paper)", "PU-RBF, fits of 20-60 samples", "Hoppe signed distance", "screened Poisson"]
 
 
 def surface_distances(vertices, faces, truth_vertices, truth_faces, samples=20000):
@@ -106,6 +111,9 @@ def main(argv=None):
     p.add_argument("--chamfer", type=int, nargs="+", metavar="RESOLUTION",
                    help="only the chamfer of each method on each case at these resolutions, and where it "
                         "comes from (median distance at the scan's vertices and on its triangles)")
+    p.add_argument("--methods", nargs="+", choices=list(METHODS), default=DEFAULT_METHODS, metavar="METHOD",
+                   help=f"rows per case, from: {'; '.join(METHODS)}; the first sets the resolution of the others (automatic), and "
+                        "the time ratio is nan without \"screened Poisson\"")
     p.add_argument("--one", nargs=3, metavar=("CASE", "METHOD", "RESOLUTION"), help=argparse.SUPPRESS)
     args = p.parse_args(argv)
     implicit_boundaries.load()
@@ -118,7 +126,7 @@ def main(argv=None):
               "| median at scan vertices | median on scan triangles |\n|---|---|---|---|---|---|")
         for case in args.cases:
             for resolution in args.chamfer:
-                for method in METHODS:
+                for method in args.methods:
                     r = child(case, args.data, method, resolution)
                     size = f"depth {poisson_depth(resolution)}" if method == "screened Poisson" else f"{resolution}"
                     print(f"| {case} | {method} | {size} | {r['chamfer_pct']:.4f} | {r['median_at_scan_vertices_pct']:.4f} "
@@ -129,12 +137,12 @@ def main(argv=None):
     print("|---|---|---|---|---|---|---|---|---|---|")
     for case in args.cases:
         rows = {}
-        first, *others = METHODS
+        first, *others = args.methods
         rows[first] = child(case, args.data, first, 0)
         resolution = int(rows[first].get("resolution", 256))
         for method in others:
             rows[method] = child(case, args.data, method, resolution)
-        poisson = rows["screened Poisson"]
+        poisson = rows.get("screened Poisson", {"error": "not run"})
         for method, r in rows.items():
             if "error" in r:
                 print(f"| {case} | {method} | {r['error']} ||||||||")
