@@ -34,7 +34,7 @@ class PointNormals
 public:
     struct Param
     {
-        int neighbours = 10;                      ///< k of the PCA fit and of the propagation
+        int neighbours = 15;                      ///< k of the PCA fit and of the propagation
         int smoothing_iterations = 0;             ///< neighbour averaging passes after the fit
         std::optional<Eigen::Vector3d> viewpoint; ///< scanner position: normals face it
         int threads = 0;                          ///< for the neighbour vote; 0 = all cores

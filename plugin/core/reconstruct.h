@@ -148,7 +148,7 @@ public:
         double sample_radius = 1.25; ///< tangent disk radius, in local sample spacings
         int sods_dilation = 0;       ///< 26-neighbourhood rings added around occupied cells
         NormalSource normals = NormalSource::LayerOrEstimate;
-        int normal_neighbours = 10;  ///< k for normal estimation
+        int normal_neighbours = 15;  ///< k for normal estimation (10 flips normals on noisy scans; see README)
         std::optional<Eigen::Vector3d> viewpoint;  ///< orient estimated normals towards it
         Implicit implicit = Implicit::PuRbf;
         PuRbf::Param rbf;            ///< the PU-RBF's cells and fits (threads: taken from `threads`)
