@@ -225,7 +225,7 @@ TEST(PuRbf, TorusWithExactNormals)
     EXPECT_LT(a.max_sd_error, 0.1);
 }
 
-// Estimated normals on clean samples tilt by less than a degree (the curvature over ten
+// Estimated normals on clean samples tilt by less than a degree (the curvature over 15
 // neighbours): the fit must be as close as with exact ones.
 TEST(PuRbf, SphereWithEstimatedNormals)
 {
