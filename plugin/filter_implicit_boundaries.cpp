@@ -461,7 +461,7 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 	res["crossed_cell_corners"] = double(r.crossed_corners);
 	res["memory_limit_gb"] = r.memory_limit / 1e9;
 	res["normals_estimated"] = r.normals_estimated;
-	res["normals_turned"] = int(r.normals_turned);
+	res["normals_turned"] = double(r.normals_turned);
 	res["seconds_normals"] = r.seconds_normals;
 	res["seconds_implicit"] = r.seconds_implicit;
 	res["seconds_sods"] = r.seconds_sods;
