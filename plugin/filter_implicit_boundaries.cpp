@@ -117,7 +117,7 @@ QString FilterImplicitBoundariesPlugin::filterInfo(ActionIDType filter) const
 	case IMPLICIT_RECONSTRUCTION_WITH_BOUNDARIES:
 		return "Reconstructs a surface <b>with its real boundaries</b> from a point cloud with normals "
 			   "(estimated when the layer has none). An implicit function is fitted to the samples "
-			   "(Hoppe's signed distance to tangent planes, the paper's partition-of-unity RBF, or the "
+			   "(by default the paper's partition-of-unity RBF; or Hoppe's signed distance to tangent planes, or the "
 			   "signed distance to a closed mesh layer such as Screened Poisson's output) and extracted "
 			   "by marching cubes, but only in the cells of a <i>spatial occupancy data structure</i> "
 			   "(SODS): the lattice cells covered by the samples' tangent disks. Where the scan has no "
