@@ -1,0 +1,176 @@
+"""Boundaries on every mesh of the data folders, under three conditions (issue: boundaries on
+unseen scans).
+
+Each mesh's vertices are the input point cloud and the mesh itself the truth (its boundary
+edges the true boundaries). Conditions: "clean" (the vertices with normals from the faces),
+"noise 0.2%" (Gaussian noise of 0.2% of the bounding-box diagonal on the points, the same
+normals), "no normals" (clean points, the filter estimates the normals). Per mesh and
+condition: loops found / true loops, boundary distance, spurious and missing area (the
+yardsticks of README "Yardsticks": surface farther than 1% of the diagonal from the other
+surface) and our time over screened Poisson's at matched depth, in the same run. A summary per
+condition and per kind of difficulty follows.
+
+    python bench/corpus.py [--data DIR] [--cases NAME ...] [--conditions clean ...] [--params k=v ...]
+"""
+import argparse
+import time
+from collections import defaultdict
+from pathlib import Path
+
+import numpy as np
+import pymeshlab
+
+import implicit_boundaries
+from implicit_boundaries.compare import poisson_depth
+from implicit_boundaries.metrics import boundary_curves, boundary_distance, boundary_vertex_sets, surface_distances
+
+DEFAULT_DATA = Path(__file__).resolve().parent.parent.parent / "shared" / "data"
+# Every mesh, with the kinds of difficulty it stands for (a mesh may have several).
+CASES = {
+    "bun_zipper.ply": "scan, small holes",
+    "mech-holes-shark.off": "CAD, holes",
+    "fandisk_truncated.off": "CAD, creases, cut",
+    "tum_rabbit.ply": "scan, open base",
+    "gargoyle.ply": "scan, closed, occlusions",
+    "corpus/spot_cut.off": "thin parts, cut",
+    "corpus/cheburashka_cut.off": "thin parts, cut",
+    "corpus/homer_cut.off": "thin parts, creases, cut",
+    "corpus/nefertiti_cut.off": "scan, uneven sampling, cut",
+    "corpus/fertility_cut.off": "thin parts, cut",
+    "corpus/max_cut.off": "uneven sampling, cut",
+    "corpus/screwdriver_cut.off": "CAD, thin parts, cut",
+    "corpus/3holes_cut.off": "CAD, creases, cut",
+    "corpus/alligator.obj": "flat",
+    "corpus/halftunnel.off": "CAD, creases, quad mesh",
+}
+CONDITIONS = ["clean", "noise 0.2%", "no normals"]
+TOLERANCE = 0.01  # spurious and missing area: farther than 1% of the diagonal
+
+
+def load_case(path):
+    """Vertices, normals from the faces (or the file's own for a point cloud), faces."""
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(str(path))
+    if ms.current_mesh().face_number() > 0:
+        ms.meshing_remove_unreferenced_vertices()
+        ms.compute_normal_per_vertex()
+    m = ms.current_mesh()
+    m.compact()
+    return m.vertex_matrix().copy(), m.vertex_normal_matrix().copy(), m.face_matrix().copy()
+
+
+def condition_input(condition, points, normals, rng):
+    diagonal = np.linalg.norm(np.ptp(points, axis=0))
+    if condition == "noise 0.2%":
+        return points + rng.normal(0, 0.002 * diagonal, points.shape), normals
+    if condition == "no normals":
+        return points, None
+    return points, normals
+
+
+def ours(points, normals, params):
+    ms = pymeshlab.MeshSet()
+    mesh = (pymeshlab.Mesh(vertex_matrix=points) if normals is None
+            else pymeshlab.Mesh(vertex_matrix=points, v_normals_matrix=normals))
+    ms.add_mesh(mesh, "points")
+    t = time.perf_counter()
+    out = implicit_boundaries.apply(ms, **params)
+    seconds = time.perf_counter() - t
+    m = ms.current_mesh()
+    return out, m.vertex_matrix().copy(), m.face_matrix().copy(), seconds
+
+
+def poisson_seconds(points, normals, resolution):
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=points, v_normals_matrix=normals), "points")
+    t = time.perf_counter()
+    ms.generate_surface_reconstruction_screened_poisson(depth=poisson_depth(resolution), threads=1)
+    return time.perf_counter() - t
+
+
+def measure(name, condition, points, normals, faces, rng, params):
+    """One row: a dict of the measures."""
+    diagonal = np.linalg.norm(np.ptp(points, axis=0))
+    step = 0.0005 * diagonal
+    true_loops = len(boundary_vertex_sets(faces, len(points))) if len(faces) else 0
+    cloud, cloud_normals = condition_input(condition, points, normals, rng)
+    out, vertices, out_faces, seconds = ours(cloud, cloud_normals, params)
+    row = {"mesh": name, "condition": condition, "samples": len(points), "true": true_loops,
+           "loops": int(out["boundary_loops"]), "edges": np.asarray(out["boundary_loop_edges"]).astype(int).tolist(),
+           "resolution": int(out["resolution"]), "outliers": int(out.get("outliers_removed", 0))}
+    if len(faces):
+        row["boundary"] = 100 * boundary_distance(boundary_curves(points, faces, step),
+                                                  boundary_curves(vertices, out_faces, step)) / diagonal
+        d = surface_distances(vertices, out_faces, points, faces, TOLERANCE * diagonal)
+        row.update(chamfer=100 * d["chamfer"] / diagonal, spurious=100 * d["spurious"], missing=100 * d["missing"])
+    else:
+        row.update(boundary=float("nan"), chamfer=float("nan"), spurious=float("nan"), missing=float("nan"))
+    poisson_normals = cloud_normals if cloud_normals is not None else normals
+    row["time_ratio"] = seconds / poisson_seconds(cloud, poisson_normals, row["resolution"])
+    return row
+
+
+def summary(rows, key, label):
+    print(f"\n| {label} | cases | exact loop count | median boundary distance (% diag) | largest "
+          "| largest spurious area (%) | largest missing area (%) | median time / Poisson |")
+    print("|---|---|---|---|---|---|---|---|")
+    groups = defaultdict(list)
+    for row in rows:
+        for k in key(row):
+            groups[k].append(row)
+    for k, group in groups.items():
+        exact = sum(r["loops"] == r["true"] for r in group)
+        bd = [r["boundary"] for r in group if np.isfinite(r["boundary"])]
+        sp = [r["spurious"] for r in group if np.isfinite(r["spurious"])]
+        mi = [r["missing"] for r in group if np.isfinite(r["missing"])]
+        fmt = lambda v, f: f"{f(v):.3f}" if v else "-"
+        print(f"| {k} | {len(group)} | {exact}/{len(group)} | {fmt(bd, np.median)} | {fmt(bd, max)} "
+              f"| {fmt(sp, max)} | {fmt(mi, max)} | {np.median([r['time_ratio'] for r in group]):.2f} |")
+
+
+def parse_params(items):
+    params = {}
+    for item in items or []:
+        key, value = item.split("=", 1)
+        for cast in (int, float):
+            try:
+                value = cast(value)
+                break
+            except ValueError:
+                pass
+        if value in ("True", "False"):
+            value = value == "True"
+        params[key] = value
+    return params
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p.add_argument("--data", type=Path, default=DEFAULT_DATA)
+    p.add_argument("--cases", nargs="+", default=list(CASES), help="paths under --data")
+    p.add_argument("--conditions", nargs="+", default=CONDITIONS, choices=CONDITIONS)
+    p.add_argument("--params", nargs="*", help="filter parameters, name=value")
+    args = p.parse_args(argv)
+    params = parse_params(args.params)
+    implicit_boundaries.load()
+    print("| mesh | kind | condition | samples | loops / true | largest loops | resolution | boundary distance (% diag) "
+          "| chamfer (% diag) | spurious area (%) | missing area (%) | outliers left out | time / screened Poisson |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+    rows = []
+    for name in args.cases:
+        points, normals, faces = load_case(args.data / name)
+        for condition in args.conditions:
+            rng = np.random.default_rng(len(points))  # the same noise in every run
+            row = measure(name, condition, points, normals, faces, rng, params)
+            rows.append(row)
+            mark = "" if row["loops"] == row["true"] else " ✗"
+            print(f"| {Path(name).name} | {CASES.get(name, '')} | {condition} | {row['samples']} "
+                  f"| {row['loops']} / {row['true']}{mark} | {row['edges'][:5]} | {row['resolution']} "
+                  f"| {row['boundary']:.3f} | {row['chamfer']:.4f} | {row['spurious']:.3f} | {row['missing']:.3f} "
+                  f"| {row['outliers']} | {row['time_ratio']:.2f} |", flush=True)
+    summary(rows, lambda r: [r["condition"]], "condition")
+    summary(rows, lambda r: [k.strip() for k in CASES.get(r["mesh"], "other").split(",")], "kind")
+
+
+if __name__ == "__main__":
+    main()
