@@ -213,7 +213,9 @@ def test_moebius_strip_has_one_loop_and_one_seam(implicit):
     _, on_strip = cKDTree(points).query(loop[seam])
     angles = u[on_strip]
     spread = np.angle(np.exp(1j * (angles - angles[0])))  # around the circle
-    assert np.ptp(spread) < 0.2  # one cut, not several
+    # One cut, not several: a straight cut, even slanted by 45 degrees across the strip (0.6
+    # wide, on a unit circle), spans at most 0.6 radians along it.
+    assert np.ptp(spread) < 0.6
     check_oriented_manifold(rec.vertices, rec.faces)
 
 

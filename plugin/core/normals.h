@@ -1,9 +1,10 @@
 #pragma once
 /// \file normals.h
-/// Normals for point sets that come without them: PCA planes over k neighbours, oriented
-/// consistently by VCGlib (vcg::tri::PointCloudNormal: Hoppe et al. 1992's propagation over
-/// the neighbour graph, or towards a viewpoint when one is given), then a neighbour vote
-/// that turns the few normals the propagation got wrong.
+/// Normals for point sets that come without them: PCA planes over k neighbours (VCGlib's
+/// vcg::tri::PointCloudNormal), oriented towards a viewpoint when one is given, else by
+/// propagation over the neighbour graph (Hoppe et al. 1992) with the mirror rule of König and
+/// Gumhold 2009 (Propagate), then a neighbour vote that turns the few normals the propagation
+/// got wrong.
 
 #include "lattice.h"
 #include "parallel.h"
@@ -13,6 +14,8 @@
 #include <vcg/complex/algorithms/pointcloud_normal.h>
 
 #include <optional>
+#include <queue>
+#include <tuple>
 
 namespace ib {
 
@@ -43,14 +46,14 @@ public:
     /// What Compute did beyond the PCA fit.
     struct Report
     {
-        bool flipped = false;   ///< the whole set was turned to point away from the centroid
+        bool flipped = false;   ///< a connected piece was turned to point away from its centroid
         size_t turned = 0;      ///< normals turned by the neighbour vote
     };
 
     /// n×3 unit normals of the n×3 samples samples.P(). Without a viewpoint, propagation fixes
-    /// the orientation only up to one global flip per connected neighbour graph; we flip the
-    /// whole set so that most normals point away from the centroid (right for a scan of one
-    /// object).
+    /// the orientation only up to one flip per connected piece of the neighbour graph; each
+    /// piece is turned so that most of its normals point away from its centroid (right for a
+    /// scan of one object).
     static Points Compute(const SampleIndex& samples, const Param& p, Report* report = nullptr)
     {
         const Points& P = samples.P();
@@ -61,12 +64,8 @@ public:
 
         vcg::tri::PointCloudNormal<PointCloud>::Param vp;
         vp.fittingAdjNum = p.neighbours;
-        vp.coherentAdjNum = p.neighbours;
         vp.smoothingIterNum = p.smoothing_iterations;
-        if (p.viewpoint) {
-            vp.useViewPoint = true;
-            vp.viewPoint = vcg::Point3d((*p.viewpoint)[0], (*p.viewpoint)[1], (*p.viewpoint)[2]);
-        }
+        vp.coherentAdjNum = 0;  // the planes only: oriented below
         vcg::tri::PointCloudNormal<PointCloud>::Compute(m, vp, nullptr);
 
         Points N(P.rows(), 3);
@@ -75,20 +74,127 @@ public:
             n.Normalize();
             N.row(i) << n[0], n[1], n[2];
         }
-        const size_t turned = TurnOutvoted(samples, p.neighbours, p.threads, N);
-        bool flip = false;
-        if (!p.viewpoint) {
-            const Eigen::RowVector3d centroid = P.colwise().mean();
-            flip = ((P.rowwise() - centroid).array() * N.array()).rowwise().sum().sum() < 0;
-            if (flip)
-                N = -N;
+        Report r;
+        if (p.viewpoint) {
+            for (Eigen::Index i = 0; i < P.rows(); ++i)
+                if (N.row(i).dot(p.viewpoint->transpose() - P.row(i)) < 0)
+                    N.row(i) = -N.row(i);
+        } else {
+            r.flipped = Propagate(samples, p.neighbours, N);
         }
+        r.turned = TurnOutvoted(samples, p.neighbours, p.threads, N);
         if (report)
-            *report = Report{flip, turned};
+            *report = r;
         return N;
     }
 
 private:
+    /// Orients the unoriented unit normals N in place, growing each connected piece of the
+    /// k-nearest-neighbour graph from its first sample, most confident step first (Prim's
+    /// order, Hoppe et al. 1992). A sample is oriented by the votes of all its oriented
+    /// neighbours, not by the one step that reached it: each votes for its own normal
+    /// reflected across the plane bisecting the two samples (König and Gumhold, "Consistent
+    /// propagation of normal orientations in point clouds", VMV 2009: on a circle through both
+    /// samples their outward normals are such mirror images; on one flat sheet the mirror is
+    /// the normal itself, Hoppe's rule). A vote counts by how well it agrees with the sample's
+    /// plane and by how nearly the two lie in each other's tangent plane: with scan noise, a
+    /// step out of the plane is unreliable, so steps along the sheet go first. Unlike VCGlib's
+    /// propagation, no step is dropped for normals far apart (there, each region it could not
+    /// reach got an arbitrary side). Measured over the corpus without normals (bench/corpus.py):
+    /// 10 of 15 meshes with exactly their boundaries, against 8 with VCGlib's propagation (a
+    /// cartoon cow and a cartoon figure: inside-out regions behind seams before). Neither
+    /// orients both sides of a closed plate thinner than about 3 spacings. Returns true when a
+    /// piece was turned to face away from its centroid.
+    static bool Propagate(const SampleIndex& index, int k, Points& N)
+    {
+        const Points& P = index.P();
+        const Eigen::Index n = P.rows();
+        std::vector<char> done(size_t(n), 0);
+        using Step = std::tuple<double, Eigen::Index, Eigen::Index>;  // confidence, -target, source
+        std::priority_queue<Step> frontier;
+        SampleIndex::Queue queue;
+        // The vote of oriented sample j on sample i's orientation, weighted by its confidence.
+        auto vote = [&](Eigen::Index j, Eigen::Index i) {
+            const double agreement = Mirror(P, N, j, i).dot(N.row(i));
+            return agreement * std::abs(agreement) * Clarity(P, N, j, i);
+        };
+        // Orients sample i, reached from `source`, by the votes of its oriented neighbours and
+        // the source (one noisy step alone can mislead), then offers the steps to its other
+        // neighbours.
+        auto visit = [&](Eigen::Index i, Eigen::Index source) {
+            index.Nearest(P.row(i).transpose(), k + 1, queue);
+            double votes = source >= 0 ? vote(source, i) : 0;
+            for (int q = 0; q < queue.getNofElements(); ++q) {
+                const Eigen::Index j = queue.getIndex(q);
+                if (j != i && j != source && done[size_t(j)])
+                    votes += vote(j, i);
+            }
+            if (votes < 0)
+                N.row(i) = -N.row(i);
+            done[size_t(i)] = 1;
+            for (int q = 0; q < queue.getNofElements(); ++q) {
+                const Eigen::Index j = queue.getIndex(q);
+                if (done[size_t(j)])
+                    continue;
+                const double confidence = std::abs(Mirror(P, N, i, j).dot(N.row(j))) * Clarity(P, N, i, j);
+                frontier.emplace(confidence, -j, i);
+            }
+        };
+        bool flipped = false;
+        std::vector<Eigen::Index> piece;
+        for (Eigen::Index seed = 0; seed < n; ++seed) {
+            if (done[size_t(seed)])
+                continue;
+            piece.assign(1, seed);
+            visit(seed, -1);
+            while (!frontier.empty()) {
+                const auto [confidence, target, source] = frontier.top();
+                frontier.pop();
+                if (done[size_t(-target)])
+                    continue;
+                piece.push_back(-target);
+                visit(-target, source);
+            }
+            Eigen::RowVector3d centroid = Eigen::RowVector3d::Zero();
+            for (Eigen::Index i : piece)
+                centroid += P.row(i);
+            centroid /= double(piece.size());
+            double outward = 0;
+            for (Eigen::Index i : piece)
+                outward += (P.row(i) - centroid).dot(N.row(i));
+            if (outward < 0) {
+                for (Eigen::Index i : piece)
+                    N.row(i) = -N.row(i);
+                flipped = true;
+            }
+        }
+        return flipped;
+    }
+
+    /// Unit vector from sample i to sample j (zero for coincident samples).
+    static Eigen::RowVector3d Direction(const Points& P, Eigen::Index i, Eigen::Index j)
+    {
+        const Eigen::RowVector3d d = P.row(j) - P.row(i);
+        const double length = d.norm();
+        return length > 0 ? Eigen::RowVector3d(d / length) : Eigen::RowVector3d::Zero();
+    }
+
+    /// How much a step from sample i to sample j can be trusted, 1 to 0: fully where j lies in
+    /// i's tangent plane, not at all along its normal. (Trusting steps straight along the
+    /// normal too, where the mirror would orient a thin plate's far side, turned whole regions
+    /// of a noisy torus inside out: scan noise looks the same at that scale.)
+    static double Clarity(const Points& P, const Points& N, Eigen::Index i, Eigen::Index j)
+    {
+        return 1 - std::abs(Direction(P, i, j).dot(N.row(i)));
+    }
+
+    /// Normal i reflected across the plane bisecting samples i and j.
+    static Eigen::RowVector3d Mirror(const Points& P, const Points& N, Eigen::Index i, Eigen::Index j)
+    {
+        const Eigen::RowVector3d d = Direction(P, i, j);
+        return N.row(i) - 2 * N.row(i).dot(d) * d;
+    }
+
     /// Propagation (and a viewpoint at grazing angles) passes a wrong orientation on through a
     /// noisy normal now and then: an isolated sample or a small group then faces the other way
     /// and bends the implicit function into a dimple (a torus with 0.5%-diagonal noise and 10
