@@ -254,6 +254,11 @@ RichParameterList FilterImplicitBoundariesPlugin::reconstructionParameters(const
 		"hole_layer", false, "Hole triangles in their own layer",
 		"Also add a layer '<input> holes' with the triangles that close the kept holes: showing "
 		"both layers gives the closed surface, hiding it the surface with boundaries."));
+	par.addParam(RichBool(
+		"outlier_layer", false, "Outliers in their own layer",
+		"Also add a layer '<input> outliers' with the samples left out as outliers: samples that "
+		"no other sample has among its 8 nearest (stray points off the surface). They never "
+		"shape the surface, the lattice or the boundaries; the log says how many there were."));
 	par.addParam(RichEnum(
 		"normals", int(d.normals), kNormalSources, "Normals",
 		"Where the oriented normals that define inside and outside come from. 'Use layer normals' "
@@ -326,6 +331,7 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 	p.boundary_smoothing = par.getInt("boundary_smoothing");
 	p.boundary_fit = par.getBool("boundary_fit");
 	const bool holeLayer = par.getBool("hole_layer");
+	const bool outlierLayer = par.getBool("outlier_layer");
 	p.occupancy = ib::Reconstruction::Occupancy(par.getEnum("sods_occupancy"));
 	p.sample_radius = par.getFloat("sample_radius");
 	p.extraction = ib::GatedMarchingCubes::Extraction(par.getEnum("extraction"));
@@ -344,10 +350,10 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 
 	ib::CoreMesh surface, holes;
 	ib::Reconstruction::Result r;
+	const ib::Points positions = vertexMatrix(input->cm, false);
 	try {
-		r = ib::Reconstruction::Compute(
-			vertexMatrix(input->cm, false), vertexMatrix(input->cm, true), p, surface,
-			holeLayer ? &holes : nullptr, cb);
+		r = ib::Reconstruction::Compute(positions, vertexMatrix(input->cm, true), p, surface,
+										holeLayer ? &holes : nullptr, cb);
 	}
 	catch (const ib::InputError& e) {
 		throw MLException(QString("Implicit reconstruction with boundaries: ") + e.what());
@@ -381,8 +387,16 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 			added.push_back(holeModel->id());
 			vcg::tri::Append<CMeshO, ib::CoreMesh>::MeshCopyConst(holeModel->cm, holes);
 			holeModel->updateBoxAndNormals();
-			md.setCurrentMesh(out->id());
 		}
+		if (outlierLayer && !r.outliers.empty()) {
+			MeshModel* outlierModel = md.addNewMesh("", input->label() + " outliers", false);
+			added.push_back(outlierModel->id());
+			auto v = vcg::tri::Allocator<CMeshO>::AddVertices(outlierModel->cm, r.outliers.size());
+			for (Eigen::Index row : r.outliers)
+				(v++)->P() = Point3m(Scalarm(positions(row, 0)), Scalarm(positions(row, 1)), Scalarm(positions(row, 2)));
+			outlierModel->updateBoxAndNormals();
+		}
+		md.setCurrentMesh(out->id());
 	}
 	catch (const std::bad_alloc&) {
 		for (unsigned int id : added)
@@ -401,6 +415,9 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 
 	if (r.duplicates_removed > 0)
 		log("Ignored %zu vertices at the same position as another one.", r.duplicates_removed);
+	if (!r.outliers.empty())
+		log("Left out %zu outliers: samples that no other sample has among its 8 nearest (stray points off "
+			"the surface)%s.", r.outliers.size(), outlierLayer ? ", in the layer '<input> outliers'" : "");
 	if (r.normals_estimated)
 		log("Input had no usable normals (or estimation was requested): estimated them from %d "
 			"neighbours and oriented them %s%s; %zu turned to agree with their neighbours.",
@@ -448,6 +465,8 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 	res["seam_points"] = double(r.seam_points);
 	res["faces_cut_at_seams"] = double(r.faces_cut_at_seams);
 	res["duplicates_removed"] = double(r.duplicates_removed);
+	res["outliers_removed"] = double(r.outliers.size());
+	res["faces_unsupported"] = double(r.faces_unsupported);
 	res["surface_faces"] = out->cm.fn;
 	res["surface_vertices"] = out->cm.vn;
 	res["resolution"] = r.resolution;

@@ -78,29 +78,67 @@ public:
     /// adjacency, as Compute. Returns faces removed.
     static size_t RemoveScraps(const CoreMesh& mesh, std::vector<char>& inSurface, size_t min_faces)
     {
-        std::vector<int> piece(mesh.face.size(), -1);
         size_t removed = 0;
-        for (size_t seed = 0; seed < mesh.face.size(); ++seed) {
-            if (!inSurface[seed] || piece[seed] >= 0)
-                continue;
-            std::vector<int> members{int(seed)};
-            piece[seed] = int(seed);
-            for (size_t i = 0; i < members.size(); ++i)
-                for (int e = 0; e < 3; ++e)
-                    if (const int g = Across(mesh, size_t(members[i]), e, inSurface); g >= 0 && piece[size_t(g)] < 0) {
-                        piece[size_t(g)] = int(seed);
-                        members.push_back(g);
-                    }
-            if (members.size() < min_faces) {
-                for (int f : members)
+        for (const std::vector<int>& piece : Pieces(mesh, inSurface))
+            if (piece.size() < min_faces) {
+                for (int f : piece)
                     inSurface[size_t(f)] = 0;
-                removed += members.size();
+                removed += piece.size();
             }
+        return removed;
+    }
+
+    /// Removes (sets inSurface to 0) the connected pieces of surface whose faces have fewer
+    /// than `min_samples` distinct nearest samples: a surface needs that many samples to be
+    /// defined at all (the input's own minimum), so such a piece is the implicit function's
+    /// bubble around a few stray samples off the surface (outliers that claim each other as
+    /// neighbours in a group too small for outliers.h to tell), or a scrap of the trim. Needs
+    /// face-face adjacency, as Compute. Returns faces removed.
+    static size_t RemoveUnsupported(const CoreMesh& mesh, const SampleIndex& samples, size_t min_samples,
+                                    std::vector<char>& inSurface)
+    {
+        size_t removed = 0;
+        SampleIndex::Queue queue;
+        for (const std::vector<int>& piece : Pieces(mesh, inSurface)) {
+            std::vector<Eigen::Index> nearest;
+            for (size_t i = 0; i < piece.size() && nearest.size() < min_samples; ++i) {
+                const vcg::Point3d c = vcg::Barycenter(mesh.face[size_t(piece[i])]);
+                samples.Nearest(Eigen::Vector3d(c[0], c[1], c[2]), 1, queue);
+                if (std::find(nearest.begin(), nearest.end(), queue.getIndex(0)) == nearest.end())
+                    nearest.push_back(queue.getIndex(0));
+            }
+            if (nearest.size() >= min_samples)
+                continue;
+            for (int f : piece)
+                inSurface[size_t(f)] = 0;
+            removed += piece.size();
         }
         return removed;
     }
 
 private:
+    /// The connected pieces of the faces with inSurface (face indices, each piece in the order
+    /// of a breadth-first walk from its lowest face).
+    static std::vector<std::vector<int>> Pieces(const CoreMesh& mesh, const std::vector<char>& inSurface)
+    {
+        std::vector<std::vector<int>> pieces;
+        std::vector<char> seen(mesh.face.size(), 0);
+        for (size_t seed = 0; seed < mesh.face.size(); ++seed) {
+            if (!inSurface[seed] || seen[seed])
+                continue;
+            std::vector<int> members{int(seed)};
+            seen[seed] = 1;
+            for (size_t i = 0; i < members.size(); ++i)
+                for (int e = 0; e < 3; ++e)
+                    if (const int g = Across(mesh, size_t(members[i]), e, inSurface); g >= 0 && !seen[size_t(g)]) {
+                        seen[size_t(g)] = 1;
+                        members.push_back(g);
+                    }
+            pieces.push_back(std::move(members));
+        }
+        return pieces;
+    }
+
     /// True when the kAround samples nearest to the face's centroid, projected onto the face's
     /// plane, leave an angular gap wider than kOutsideGap around it.
     static bool SamplesOnOneSide(const CoreFace& face, const SampleIndex& samples, SampleIndex::Queue& queue)

@@ -14,6 +14,7 @@
 #include "memory_budget.h"
 #include "normals.h"
 #include "orientation_seam.h"
+#include "outliers.h"
 #include "pinches.h"
 #include "sods.h"
 #include "spacing.h"
@@ -181,6 +182,8 @@ public:
         size_t faces_cut_at_seams = 0;    ///< surface faces removed around those points
         size_t boundary_vertices_fitted = 0;  ///< boundary vertices moved onto the samples' edge
         size_t duplicates_removed = 0;    ///< samples at the same position as an earlier one
+        std::vector<Eigen::Index> outliers;  ///< input rows left out as outliers (outliers.h), ascending
+        size_t faces_unsupported = 0;     ///< faces of pieces supported by fewer than kMinPoints samples
         size_t hole_cells = 0;
         bool hole_search_capped = false;
         int resolution = 0;
@@ -231,15 +234,31 @@ private:
         Result r;
         // Repeated samples (merged scans, exported meshes with seams) would make every
         // neighbourhood collapse to one point and the spacing zero: keep one of each.
-        const std::vector<Eigen::Index> kept = DistinctRows(input);
+        std::vector<Eigen::Index> kept = DistinctRows(input);
         r.duplicates_removed = size_t(input.rows() - Eigen::Index(kept.size()));
+        if (Eigen::Index(kept.size()) < kMinPoints)
+            throw InputError("Only " + std::to_string(kept.size()) + " distinct vertex positions; at least " +
+                             std::to_string(kMinPoints) + " are needed to fit tangent planes.");
+        auto t = Clock::now();
+        {
+            const Points distinct = input(kept, Eigen::all);
+            const std::vector<Eigen::Index> inliers = Outliers::Kept(SampleIndex(distinct), p.threads);
+            r.outliers.reserve(kept.size() - inliers.size());
+            for (size_t i = 0, j = 0; i < kept.size(); ++i) {
+                if (j < inliers.size() && inliers[j] == Eigen::Index(i))
+                    kept[j++] = kept[i];
+                else
+                    r.outliers.push_back(kept[i]);
+            }
+            kept.resize(inliers.size());
+        }
         const Points P = input(kept, Eigen::all);
         const Points N = inputNormals.rows() ? Points(inputNormals(kept, Eigen::all)) : Points();
         if (P.rows() < kMinPoints)
-            throw InputError("Only " + std::to_string(P.rows()) + " distinct vertex positions; at least " +
-                             std::to_string(kMinPoints) + " are needed to fit tangent planes.");
+            throw InputError("Only " + std::to_string(P.rows()) + " samples are left once " +
+                             std::to_string(r.outliers.size()) + " outliers (samples far from all others) are left " +
+                             "out; at least " + std::to_string(kMinPoints) + " are needed to fit tangent planes.");
 
-        auto t = Clock::now();
         const SampleIndex samples(P);  // the k-d tree every stage shares, from normals to the trim
         const Points normals = OrientedNormals(samples, N, p, r, cb);
         r.seconds_normals = seconds(t);
@@ -394,6 +413,7 @@ public:
         if (p.boundary_trim > 0)
             r.faces_trimmed = BoundaryTrim::Compute(all, samples, p.boundary_trim * spacing, inSurface, p.threads);
         r.faces_unpinched = Pinches::Resolve(all, inSurface);
+        r.faces_unsupported = BoundaryTrim::RemoveUnsupported(all, samples, kMinPoints, inSurface);
         // A piece smaller than the smallest hole kept, or than a few cells when every hole is
         // kept, is a scrap of the trim.
         if (p.boundary_trim > 0)

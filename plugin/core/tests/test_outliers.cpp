@@ -1,0 +1,65 @@
+// Outliers::Kept on generated point sets: strays alone or in small groups are found, surface
+// samples are not, however uneven their density.
+
+#include "outliers.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+using namespace ib;
+
+namespace {
+
+/// A flat square scan, z = 0: a coarse grid (spacing 0.1) on x < 0, a grid 10 times denser on
+/// x >= 0 (the abrupt density change of a scan at a grazing angle next to a frontal one).
+std::vector<Eigen::RowVector3d> UnevenPlane()
+{
+    std::vector<Eigen::RowVector3d> ps;
+    for (double x = -2; x < 0; x += 0.1)
+        for (double y = -2; y <= 2; y += 0.1)
+            ps.emplace_back(x, y, 0);
+    for (double x = 0; x <= 0.5; x += 0.01)
+        for (double y = -0.5; y <= 0.5; y += 0.01)
+            ps.emplace_back(x, y, 0);
+    return ps;
+}
+
+Points Stack(const std::vector<Eigen::RowVector3d>& ps)
+{
+    Points P(Eigen::Index(ps.size()), 3);
+    for (size_t i = 0; i < ps.size(); ++i)
+        P.row(Eigen::Index(i)) = ps[i];
+    return P;
+}
+
+} // namespace
+
+TEST(Outliers, KeepsEverySampleOfAnUnevenScan)
+{
+    const Points P = Stack(UnevenPlane());
+    EXPECT_EQ(Outliers::Kept(SampleIndex(P)).size(), size_t(P.rows()));
+}
+
+TEST(Outliers, FindsStraysAloneAndInSmallGroups)
+{
+    std::vector<Eigen::RowVector3d> ps = UnevenPlane();
+    const size_t surface = ps.size();
+    ps.emplace_back(0, 0, 100);  // far away
+    ps.emplace_back(-1, 1, 0.7);  // above the coarse part, 7 spacings off
+    std::mt19937 rng(1);
+    std::uniform_real_distribution<double> u(-2, 2);
+    for (int i = 0; i < 3; ++i)   // a group of three, each the others' nearest
+        ps.emplace_back(1.5 + 0.05 * i, 1.5, 1 + 0.05 * u(rng));
+    const Points P = Stack(ps);
+    const std::vector<Eigen::Index> kept = Outliers::Kept(SampleIndex(P));
+    ASSERT_EQ(kept.size(), surface);
+    for (size_t i = 0; i < surface; ++i)
+        EXPECT_EQ(kept[i], Eigen::Index(i));
+}
+
+TEST(Outliers, KeepsEveryOneOfFewSamples)
+{
+    const Points P = Stack({{0, 0, 0}, {1, 0, 0}, {100, 0, 0}});
+    EXPECT_EQ(Outliers::Kept(SampleIndex(P)).size(), 3u);
+}
