@@ -4,7 +4,10 @@ unseen scans).
 Each mesh's vertices are the input point cloud and the mesh itself the truth (its boundary
 edges the true boundaries). Conditions: "clean" (the vertices with normals from the faces),
 "noise 0.2%" (Gaussian noise of 0.2% of the bounding-box diagonal on the points, the same
-normals), "no normals" (clean points, the filter estimates the normals). Per mesh and
+normals), "no normals" (clean points, the filter estimates the normals), "outliers 0.1%" (the
+clean input plus 0.1% of its sample count drawn uniformly in the bounding box with random
+normals, and one sample at ten times the diagonal; its time is over the clean run's, and the
+farthest face from the true surface is in local spacings of the nearest sample). Per mesh and
 condition: loops found / true loops, boundary distance, spurious and missing area (the
 yardsticks of README "Yardsticks": surface farther than 1% of the diagonal from the other
 surface) and our time over screened Poisson's at matched depth, in the same run. A summary per
@@ -22,7 +25,9 @@ import pymeshlab
 
 import implicit_boundaries
 from implicit_boundaries.compare import poisson_depth
-from implicit_boundaries.metrics import boundary_curves, boundary_distance, boundary_vertex_sets, surface_distances
+from implicit_boundaries.metrics import (boundary_curves, boundary_distance, boundary_vertex_sets, point_mesh_distance,
+                                        surface_distances)
+from scipy.spatial import cKDTree
 
 DEFAULT_DATA = Path(__file__).resolve().parent.parent.parent / "shared" / "data"
 # Every mesh, with the kinds of difficulty it stands for (a mesh may have several).
@@ -43,7 +48,7 @@ CASES = {
     "corpus/alligator.obj": "flat",
     "corpus/halftunnel.off": "CAD, creases, quad mesh",
 }
-CONDITIONS = ["clean", "noise 0.2%", "no normals"]
+CONDITIONS = ["clean", "noise 0.2%", "no normals", "outliers 0.1%"]
 TOLERANCE = 0.01  # spurious and missing area: farther than 1% of the diagonal
 
 
@@ -63,6 +68,13 @@ def condition_input(condition, points, normals, rng):
     diagonal = np.linalg.norm(np.ptp(points, axis=0))
     if condition == "noise 0.2%":
         return points + rng.normal(0, 0.002 * diagonal, points.shape), normals
+    if condition == "outliers 0.1%":
+        count = max(1, len(points) // 1000)
+        strays = rng.uniform(points.min(axis=0), points.max(axis=0), (count, 3))
+        stray_normals = rng.normal(size=(count, 3))
+        stray_normals /= np.linalg.norm(stray_normals, axis=1, keepdims=True)
+        far = points.max(axis=0) + [10 * diagonal, 0, 0]
+        return np.vstack([points, strays, far]), np.vstack([normals, stray_normals, [[1, 0, 0]]])
     if condition == "no normals":
         return points, None
     return points, normals
@@ -88,7 +100,16 @@ def poisson_seconds(points, normals, resolution):
     return time.perf_counter() - t
 
 
-def measure(name, condition, points, normals, faces, rng, params):
+def farthest_face(vertices, faces, points, truth_faces):
+    """Largest distance from a face centroid of the result to the true mesh, over the local
+    spacing (spacing.h's estimate) of the true mesh's vertex nearest to it."""
+    tree = cKDTree(points)
+    spacing = np.sqrt(np.pi * tree.query(points, k=9)[0][:, 8] ** 2 / 8)
+    centroids = vertices[faces].mean(axis=1)
+    return float((point_mesh_distance(centroids, points, truth_faces) / spacing[tree.query(centroids)[1]]).max())
+
+
+def measure(name, condition, points, normals, faces, rng, params, clean_seconds=None):
     """One row: a dict of the measures."""
     diagonal = np.linalg.norm(np.ptp(points, axis=0))
     step = 0.0005 * diagonal
@@ -107,13 +128,17 @@ def measure(name, condition, points, normals, faces, rng, params):
         row.update(boundary=float("nan"), chamfer=float("nan"), spurious=float("nan"), missing=float("nan"))
     poisson_normals = cloud_normals if cloud_normals is not None else normals
     row["time_ratio"] = seconds / poisson_seconds(cloud, poisson_normals, row["resolution"])
+    row["seconds"] = seconds
+    row["over_clean"] = seconds / clean_seconds if clean_seconds else float("nan")
+    row["farthest"] = farthest_face(vertices, out_faces, points, faces) if len(faces) else float("nan")
     return row
 
 
 def summary(rows, key, label):
     print(f"\n| {label} | cases | exact loop count | median boundary distance (% diag) | largest "
-          "| largest spurious area (%) | largest missing area (%) | median time / Poisson |")
-    print("|---|---|---|---|---|---|---|---|")
+          "| largest spurious area (%) | largest missing area (%) | farthest face (local spacings) "
+          "| median time / Poisson | largest time / clean |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     groups = defaultdict(list)
     for row in rows:
         for k in key(row):
@@ -123,9 +148,12 @@ def summary(rows, key, label):
         bd = [r["boundary"] for r in group if np.isfinite(r["boundary"])]
         sp = [r["spurious"] for r in group if np.isfinite(r["spurious"])]
         mi = [r["missing"] for r in group if np.isfinite(r["missing"])]
+        far = [r["farthest"] for r in group if np.isfinite(r["farthest"])]
+        slower = [r["over_clean"] for r in group if np.isfinite(r["over_clean"])]
         fmt = lambda v, f: f"{f(v):.3f}" if v else "-"
         print(f"| {k} | {len(group)} | {exact}/{len(group)} | {fmt(bd, np.median)} | {fmt(bd, max)} "
-              f"| {fmt(sp, max)} | {fmt(mi, max)} | {np.median([r['time_ratio'] for r in group]):.2f} |")
+              f"| {fmt(sp, max)} | {fmt(mi, max)} | {fmt(far, max)} | {np.median([r['time_ratio'] for r in group]):.2f} "
+              f"| {fmt(slower, max)} |")
 
 
 def parse_params(items):
@@ -154,20 +182,25 @@ def main(argv=None):
     params = parse_params(args.params)
     implicit_boundaries.load()
     print("| mesh | kind | condition | samples | loops / true | largest loops | resolution | boundary distance (% diag) "
-          "| chamfer (% diag) | spurious area (%) | missing area (%) | outliers left out | time / screened Poisson |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+          "| chamfer (% diag) | spurious area (%) | missing area (%) | farthest face (local spacings) "
+          "| outliers left out | time / screened Poisson | time / clean |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     rows = []
     for name in args.cases:
         points, normals, faces = load_case(args.data / name)
+        clean_seconds = None
         for condition in args.conditions:
             rng = np.random.default_rng(len(points))  # the same noise in every run
-            row = measure(name, condition, points, normals, faces, rng, params)
+            row = measure(name, condition, points, normals, faces, rng, params, clean_seconds)
+            if condition == "clean":
+                clean_seconds = row["seconds"]
             rows.append(row)
             mark = "" if row["loops"] == row["true"] else " ✗"
             print(f"| {Path(name).name} | {CASES.get(name, '')} | {condition} | {row['samples']} "
                   f"| {row['loops']} / {row['true']}{mark} | {row['edges'][:5]} | {row['resolution']} "
                   f"| {row['boundary']:.3f} | {row['chamfer']:.4f} | {row['spurious']:.3f} | {row['missing']:.3f} "
-                  f"| {row['outliers']} | {row['time_ratio']:.2f} |", flush=True)
+                  f"| {row['farthest']:.2f} | {row['outliers']} | {row['time_ratio']:.2f} | {row['over_clean']:.2f} |",
+                  flush=True)
     summary(rows, lambda r: [r["condition"]], "condition")
     summary(rows, lambda r: [k.strip() for k in CASES.get(r["mesh"], "other").split(",")], "kind")
 

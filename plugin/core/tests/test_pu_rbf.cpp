@@ -285,6 +285,27 @@ TEST(PuRbf, TorusWithNoiseAndEstimatedNormals)
     EXPECT_LT(a.max_abs, 0.75);
 }
 
+// A lone sample in its own octree leaf above a dense flat scan: its support box must not grow
+// with the leaf's cube over the whole scan (was 17 spacings off the plane below it).
+TEST(PuRbf, LoneSampleLeafDoesNotSpanTheScan)
+{
+    const double spacing = 0.01;
+    std::vector<Eigen::RowVector3d> ps;
+    for (int i = 0; i <= 200; ++i)
+        for (int j = 0; j <= 200; ++j)
+            ps.emplace_back(-1 + spacing * i, -1 + spacing * j, 0);
+    ps.emplace_back(0.3, 0.3, 0.5);
+    Points P(Eigen::Index(ps.size()), 3), N(Eigen::Index(ps.size()), 3);
+    for (size_t i = 0; i < ps.size(); ++i) {
+        P.row(Eigen::Index(i)) = ps[i];
+        N.row(Eigen::Index(i)) << 0, 0, 1;
+    }
+    const PuRbf f(P, N);
+    Eigen::VectorXd value(P.rows() - 1);
+    f.Eval(P.topRows(P.rows() - 1), value);
+    EXPECT_LT(value.cwiseAbs().maxCoeff(), 0.05 * spacing);
+}
+
 TEST(PuRbf, SparseRegionNextToADenseOne)
 {
     // The upper hemisphere dense, the lower one 16 times sparser: the lower cells hold fewer
