@@ -80,3 +80,25 @@ def moebius(half_width=0.3, spacing=0.02):
     u, w = u.ravel(), w.ravel()
     points = np.column_stack([(1 + w * np.cos(u / 2)) * np.cos(u), (1 + w * np.cos(u / 2)) * np.sin(u), w * np.sin(u / 2)])
     return points, u, w
+
+
+def wavy_cap(n, seed=0):
+    """n random (uniformly distributed) samples of the smooth open surface r = 1 + 0.03 sin 8x
+    sin 8y over the unit directions with z > -0.2 (one boundary: the rim at the bottom), and
+    its outward normals. Random samples, not a mesh's vertices: their gaps are what a scanner
+    leaves."""
+    rng = np.random.default_rng(seed)
+    directions = np.empty((0, 3))
+    while len(directions) < n:
+        d = rng.normal(size=(2 * n, 3))
+        d /= np.linalg.norm(d, axis=1, keepdims=True)
+        directions = np.vstack([directions, d[d[:, 2] > -0.2]])
+    u = directions[:n]
+    wave = 0.03 * np.sin(8 * u[:, 0]) * np.sin(8 * u[:, 1])
+    # Gradient of |p| - (1 + wave(p / |p|)) at p = (1 + wave) u: the radial part minus the
+    # wave's gradient projected onto the tangent plane, divided by the radius.
+    grad = 0.24 * np.column_stack([np.cos(8 * u[:, 0]) * np.sin(8 * u[:, 1]),
+                                   np.sin(8 * u[:, 0]) * np.cos(8 * u[:, 1]), np.zeros(n)])
+    tangential = grad - np.sum(grad * u, axis=1, keepdims=True) * u
+    normals = u - tangential / (1 + wave)[:, None]
+    return u * (1 + wave)[:, None], normals / np.linalg.norm(normals, axis=1, keepdims=True)

@@ -4,9 +4,10 @@ noisy flat scans. Each asserts exact loop counts and closeness to the known surf
 import numpy as np
 import pymeshlab
 import pytest
+from scipy.spatial import cKDTree
 
 import implicit_boundaries
-from shapes import fibonacci_sphere
+from shapes import fibonacci_sphere, wavy_cap
 
 
 def stray_points(rng, count, lo, hi):
@@ -50,3 +51,23 @@ def test_outliers_go_to_their_own_layer_when_asked(plugin):
     assert [ms.mesh(i).vertex_number() for i in range(ms.mesh_number())] == [5003, ms.mesh(1).vertex_number(), 3]
     np.testing.assert_allclose(np.sort(ms.mesh(2).vertex_matrix(), axis=0), np.sort(strays, axis=0))
     assert ms.current_mesh_id() == 1
+
+
+@pytest.mark.parametrize("cells_per_spacing", [0, 4])
+def test_random_samples_of_an_open_surface_have_one_loop(plugin, cells_per_spacing):
+    """200,000 random samples of a smooth open surface with one boundary, at the automatic
+    resolution (cell 0.6 spacings) and at a lattice 4 times coarser than the sampling (what the
+    automatic resolution's cap gives past a few million samples): one loop, the rim, and the
+    surface within a fraction of a spacing of the true one."""
+    points, normals = wavy_cap(200_000)
+    params = {}
+    if cells_per_spacing:  # the filter's spacing estimate: sqrt(area per sample) from 8 neighbours
+        r8 = cKDTree(points).query(points[::100], k=9)[0][:, 8]
+        spacing = np.median(np.sqrt(np.pi * r8 ** 2 / 8))
+        params["resolution"] = int(round(np.ptp(points, axis=0).max() / (cells_per_spacing * spacing)))
+    rec = implicit_boundaries.reconstruct(points, normals, **params)
+    assert len(rec.loops) == 1
+    assert rec.vertices[rec.loops[0]][:, 2].max() < -0.15
+    u = rec.vertices / np.linalg.norm(rec.vertices, axis=1, keepdims=True)
+    radius = 1 + 0.03 * np.sin(8 * u[:, 0]) * np.sin(8 * u[:, 1])
+    assert np.abs(np.linalg.norm(rec.vertices, axis=1) - radius).max() < 0.5 * rec.info["sample_spacing"]
