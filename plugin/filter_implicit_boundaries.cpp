@@ -18,15 +18,29 @@ const QStringList kImplicits = {"PU-RBF (paper)", "Hoppe signed distance", "Mesh
 // Order matches ib::GatedMarchingCubes::Extraction.
 const QStringList kExtractions = {"SODS-driven", "Full lattice, gated", "Plain marching cubes"};
 
+/// The layer's vertex positions (normals = false) or normals, through its transformation
+/// matrix: where the user sees them (MeshLab's Align tool and "Set matrix" leave the vertices
+/// as they are and change the matrix). Normals go through the matrix's inverse transpose and
+/// keep their length, so that zero normals stay zero (missing).
 ib::Points vertexMatrix(const CMeshO& m, bool normals)
 {
+	Eigen::Matrix4d tr;
+	for (int i = 0; i < 4; ++i)
+		for (int j = 0; j < 4; ++j)
+			tr(i, j) = double(m.Tr.ElementAt(i, j));
+	const Eigen::Matrix3d linear = normals ? Eigen::Matrix3d(tr.topLeftCorner<3, 3>().inverse().transpose())
+										   : Eigen::Matrix3d(tr.topLeftCorner<3, 3>());
+	const Eigen::Vector3d shift = normals ? Eigen::Vector3d::Zero() : Eigen::Vector3d(tr.topRightCorner<3, 1>());
 	ib::Points out(m.vn, 3);
 	Eigen::Index row = 0;
 	for (const auto& v : m.vert) {
 		if (v.IsD())
 			continue;
 		const auto& p = normals ? v.cN() : v.cP();
-		out.row(row++) << p[0], p[1], p[2];
+		Eigen::Vector3d q = linear * Eigen::Vector3d(p[0], p[1], p[2]) + shift;
+		if (normals && q.norm() > 0)
+			q *= Eigen::Vector3d(p[0], p[1], p[2]).norm() / q.norm();
+		out.row(row++) = q.transpose();
 	}
 	return out;
 }
@@ -262,8 +276,8 @@ RichParameterList FilterImplicitBoundariesPlugin::reconstructionParameters(const
 	par.addParam(RichEnum(
 		"normals", int(d.normals), kNormalSources, "Normals",
 		"Where the oriented normals that define inside and outside come from. 'Use layer normals' "
-		"takes the layer's own (a scan's normals are usually best) and estimates them only when "
-		"the layer has none (all zero); 'Estimate' always fits them (PCA over neighbours, "
+		"takes the layer's own (a scan's normals are usually best), estimates the zero or NaN ones "
+		"among them facing the way their neighbours face, and all of them when the layer has none; 'Estimate' always fits them (PCA over neighbours, "
 		"oriented by propagation); 'Estimate, facing the viewpoint' orients them towards the "
 		"viewpoint below, the scanner's position for a single range scan (propagation can flip "
 		"whole regions of a thin or sparse scan: the surface then comes out inside-out there, "
@@ -418,6 +432,10 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 	if (!r.outliers.empty())
 		log("Left out %zu outliers: samples that no other sample has among its 8 nearest (stray points off "
 			"the surface)%s.", r.outliers.size(), outlierLayer ? ", in the layer '<input> outliers'" : "");
+	if (r.normals_filled > 0)
+		log("%zu of the layer's vertex normals were zero or NaN: estimated them from %d neighbours, facing the way "
+			"their neighbours' normals face; the other normals are the layer's.",
+			r.normals_filled, p.normal_neighbours);
 	if (r.normals_estimated)
 		log("Input had no usable normals (or estimation was requested): estimated them from %d "
 			"neighbours and oriented them %s%s; %zu turned to agree with their neighbours.",
@@ -481,6 +499,7 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 	res["memory_limit_gb"] = r.memory_limit / 1e9;
 	res["normals_estimated"] = r.normals_estimated;
 	res["normals_turned"] = double(r.normals_turned);
+	res["normals_filled"] = double(r.normals_filled);
 	res["seconds_normals"] = r.seconds_normals;
 	res["seconds_implicit"] = r.seconds_implicit;
 	res["seconds_sods"] = r.seconds_sods;

@@ -3,13 +3,18 @@ import numpy as np
 import pymeshlab
 
 
-def fibonacci_sphere(n):
-    """n nearly uniform unit vectors (points on the unit sphere, also their outward normals)."""
+def fibonacci_sphere(n, jitter=0.0, rng=None):
+    """n nearly uniform unit vectors (points on the unit sphere, also their outward normals);
+    jitter: each moved by up to that many spacings in each direction (rng required)."""
     i = np.arange(n) + 0.5
     z = 1 - 2 * i / n
     phi = np.pi * (3 - np.sqrt(5)) * i
     r = np.sqrt(1 - z * z)
-    return np.column_stack([r * np.cos(phi), r * np.sin(phi), z])
+    u = np.column_stack([r * np.cos(phi), r * np.sin(phi), z])
+    if jitter:
+        u += rng.uniform(-jitter, jitter, u.shape) * np.sqrt(4 * np.pi / n)
+        u /= np.linalg.norm(u, axis=1, keepdims=True)
+    return u
 
 
 def cylinder(radius=1.0, height=2.0, spacing=0.04):
@@ -102,3 +107,78 @@ def wavy_cap(n, seed=0):
     tangential = grad - np.sum(grad * u, axis=1, keepdims=True) * u
     normals = u - tangential / (1 + wave)[:, None]
     return u * (1 + wave)[:, None], normals / np.linalg.norm(normals, axis=1, keepdims=True)
+
+
+def thin_plate(thickness_spacings=1.5, spacing=0.02, seed=0):
+    """A closed plate (a flattened ellipsoid with semi-axes 1, 0.6 and half the thickness)
+    whose two sides are `thickness_spacings` sample spacings apart: an ear or a fin. Samples
+    about `spacing` apart on both sides (random, area-uniform), outward normals."""
+    rng = np.random.default_rng(seed)
+    c = 0.5 * thickness_spacings * spacing
+    area = 2 * np.pi * 1 * 0.6  # both sides of the flat ellipse
+    n = int(area / spacing ** 2)
+    points = np.empty((0, 3))
+    while len(points) < n:  # area-uniform on the flattened ellipsoid: by rejection on its projection
+        xy = rng.uniform(-1, 1, (4 * n, 2)) * [1, 0.6]
+        inside = (xy[:, 0] ** 2 + (xy[:, 1] / 0.6) ** 2) < 1
+        xy = xy[inside]
+        z = c * np.sqrt(np.maximum(0, 1 - xy[:, 0] ** 2 - (xy[:, 1] / 0.6) ** 2))
+        side = rng.choice([-1, 1], len(xy))
+        points = np.vstack([points, np.column_stack([xy, side * z])])
+    points = points[:n]
+    normals = points / np.array([1, 0.36, c * c])
+    return points, normals / np.linalg.norm(normals, axis=1, keepdims=True)
+
+
+def v_groove(opening_degrees=30, spacing=0.02, seed=0):
+    """An open sheet folded into a V-groove of the given opening angle along the y axis (a
+    sharp concave crease), flanks 1 long and 2 wide, jittered-grid samples `spacing` apart,
+    normals pointing into the groove. One boundary: its rim."""
+    rng = np.random.default_rng(seed)
+    half = np.radians(opening_degrees) / 2
+    u, y = np.meshgrid(np.arange(-1, 1, spacing) + spacing / 2, np.arange(-1, 1 + 1e-9, spacing))
+    u = u.ravel() + rng.uniform(-0.3, 0.3, u.size) * spacing
+    y = y.ravel() + rng.uniform(-0.3, 0.3, y.size) * spacing
+    side = np.sign(u)
+    points = np.column_stack([np.abs(u) * np.sin(half) * side, y, np.abs(u) * np.cos(half)])
+    normals = np.column_stack([-side * np.cos(half), np.zeros_like(u), np.full_like(u, np.sin(half))])
+    return points, normals
+
+
+def uneven_hemisphere(ratio=10, smooth=False, n_dense=40000, seed=0):
+    """The upper unit hemisphere (one boundary, its rim at z = 0), sampled `ratio` times more
+    sparsely (in spacing) on the x < 0 half than on the x > 0 half. Abruptly at x = 0, as a
+    scan's range grid changes at a fold: each half a jittered Fibonacci spiral; or smoothly
+    over x in [-0.5, 0.5], as an adaptive decimation does: random samples, thinned. Outward
+    normals."""
+    rng = np.random.default_rng(seed)
+    if smooth:
+        d = rng.normal(size=(4 * n_dense, 3))
+        d /= np.linalg.norm(d, axis=1, keepdims=True)
+        d = d[d[:, 2] > 0][:2 * n_dense]
+        t = np.clip(d[:, 0] + 0.5, 0, 1)
+        d = d[rng.random(len(d)) < ratio ** (-2 * (1 - t))]  # density falls by ratio squared
+        return d, d.copy()
+    halves = []
+    for n, side in ((4 * n_dense, 1), (4 * n_dense // ratio ** 2, -1)):  # points on the whole sphere
+        d = fibonacci_sphere(n, jitter=0.3, rng=rng)
+        halves.append(d[(d[:, 2] > 0) & (side * d[:, 0] > 0)])
+    d = np.vstack(halves)
+    return d, d.copy()
+
+
+def terrain_with_pond(spacing=0.01, noise=0.002, seed=0):
+    """A terrain z = 0.1 sin(3x) cos(2y) over the unit square with a round pond (a hole of
+    radius 0.15 at (0.6, 0.4)): two boundaries. Jittered-grid samples `spacing` apart, Gaussian
+    noise of `noise` times the bounding-box diagonal on the points, exact normals."""
+    rng = np.random.default_rng(seed)
+    x, y = np.meshgrid(np.arange(0, 1 + 1e-9, spacing), np.arange(0, 1 + 1e-9, spacing))
+    x = np.clip(x.ravel() + rng.uniform(-0.3, 0.3, x.size) * spacing, 0, 1)
+    y = np.clip(y.ravel() + rng.uniform(-0.3, 0.3, y.size) * spacing, 0, 1)
+    dry = np.hypot(x - 0.6, y - 0.4) > 0.15
+    x, y = x[dry], y[dry]
+    z = 0.1 * np.sin(3 * x) * np.cos(2 * y)
+    normals = np.column_stack([-0.3 * np.cos(3 * x) * np.cos(2 * y), 0.2 * np.sin(3 * x) * np.sin(2 * y), np.ones_like(x)])
+    points = np.column_stack([x, y, z])
+    points += rng.normal(0, noise * np.linalg.norm(np.ptp(points, axis=0)), points.shape)
+    return points, normals / np.linalg.norm(normals, axis=1, keepdims=True)

@@ -304,8 +304,6 @@ def with_row(array, row, value):
 REFUSED = {
     "infinite coordinate": (lambda: (with_row(flat_scan()[0], 5, [np.inf, 0, 0]), None), {},
                             "1 of 600 vertices have NaN or infinite"),
-    "one zero normal": (lambda: (flat_scan()[0], with_row(flat_scan()[1], 5, 0)), {}, "1 of 600 vertex normals are zero or NaN"),
-    "one NaN normal": (lambda: (flat_scan()[0], with_row(flat_scan()[1], 5, np.nan)), {}, "zero or NaN"),
     "resolution 7": (flat_scan, dict(resolution=7), "Resolution 7 is out of range"),
     "dilation 9": (flat_scan, dict(sods_dilation=9), "SODS dilation must be between 0 and 8"),
     "radius 8.5": (flat_scan, dict(sample_radius=8.5), "sample radius must be between 0.25 and 8"),

@@ -200,6 +200,7 @@ public:
         bool normals_estimated = false;
         bool normals_flipped = false;
         size_t normals_turned = 0;        ///< estimated normals turned to agree with their neighbours
+        size_t normals_filled = 0;        ///< zero or NaN normals among given ones, estimated
         double seconds_normals = 0, seconds_implicit = 0, seconds_sods = 0, seconds_extraction = 0,
                seconds_boundaries = 0;
     };
@@ -373,8 +374,20 @@ public:
     static Points OrientedNormals(const SampleIndex& samples, const Points& N, const Param& p, Result& r,
                                   vcg::CallBackPos* cb)
     {
-        if (p.normals == NormalSource::LayerOrEstimate && HasNormals(N))
-            return N.rowwise().normalized();
+        if (p.normals == NormalSource::LayerOrEstimate && HasNormals(N)) {
+            Points normals = N;
+            std::vector<Eigen::Index> missing;
+            for (Eigen::Index i = 0; i < N.rows(); ++i) {
+                const double length = N.row(i).norm();
+                if (std::isfinite(length) && length > 0)
+                    normals.row(i) /= length;
+                else
+                    missing.push_back(i);
+            }
+            PointNormals::FillMissing(samples, normals, missing, p.normal_neighbours);
+            r.normals_filled = missing.size();
+            return normals;
+        }
         if (cb) cb(2, "Estimating normals");
         PointNormals::Param np;
         np.neighbours = p.normal_neighbours;
@@ -602,14 +615,6 @@ private:
             throw InputError("Normal neighbours must be between 3 and 256.");
         if (N.rows() != 0 && N.rows() != P.rows())
             throw InputError("There must be one normal per vertex.");
-        if (p.normals == NormalSource::LayerOrEstimate && HasNormals(N)) {
-            const Eigen::Index unusable =
-                (!(N.array().isFinite().rowwise().all()) || !(N.rowwise().squaredNorm().array() > 0)).count();
-            if (unusable > 0)
-                throw InputError(std::to_string(unusable) + " of " + std::to_string(N.rows()) +
-                                 " vertex normals are zero or NaN: choose to estimate normals, or remove those "
-                                 "vertices (Conditional Vertex Selection with nx==0 && ny==0 && nz==0).");
-        }
     }
 };
 

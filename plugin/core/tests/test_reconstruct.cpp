@@ -99,9 +99,34 @@ TEST(Reconstruction, RejectsBadInputWithClearMessages)
     EXPECT_NE(message(P, N, p).find("out of range"), std::string::npos);
     Points same = Points::Ones(20, 3);
     EXPECT_NE(message(same, Points(), {}).find("same position"), std::string::npos);
-    Points zeroSome = N;
-    zeroSome.row(3).setZero();
-    EXPECT_NE(message(P, zeroSome, {}).find("zero or NaN"), std::string::npos);
+}
+
+TEST(Reconstruction, FillsMissingNormalsAndKeepsTheGivenOnes)
+{
+    // A sphere whose given normals point inward (the layer's own orientation, which estimation
+    // by propagation would turn outward), with a patch of 30 zero and one NaN normal: the
+    // missing ones are estimated facing the way their neighbours face, and the sphere comes
+    // out closed and inside out, as the given normals say.
+    Points P, N;
+    test::SpherePoints(3000, 1.0, P, N);
+    N = -N;
+    std::vector<Eigen::Index> patch;
+    for (Eigen::Index i = 0; i < P.rows(); ++i)
+        if ((P.row(i) - Eigen::RowVector3d(0, 0, 1)).norm() < 0.2)
+            patch.push_back(i);
+    ASSERT_GE(patch.size(), 20u);
+    for (Eigen::Index i : patch)
+        N.row(i).setZero();
+    N(P.rows() - 1, 0) = std::numeric_limits<double>::quiet_NaN();  // the south pole
+    CoreMesh m;
+    const auto r = Reconstruction::Compute(P, N, {}, m);
+    EXPECT_EQ(r.normals_filled, patch.size() + 1);
+    EXPECT_FALSE(r.normals_estimated);
+    EXPECT_TRUE(r.loops.empty());
+    size_t inward = 0;
+    for (const CoreFace& f : m.face)
+        inward += vcg::TriangleNormal(f).dot(vcg::Barycenter(f)) < 0;
+    EXPECT_EQ(inward, m.face.size());
 }
 
 TEST(Reconstruction, SameOutputOnOneAndTwoThreads)

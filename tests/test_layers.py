@@ -1,0 +1,67 @@
+"""How MeshLab hands scans to the filter: a layer's transformation matrix (what the Align tool
+and "Set matrix" change) and layers whose normals are only partly given (MeshLab's import of a
+range scan leaves zero normals on grid points no triangle uses)."""
+import numpy as np
+import pymeshlab
+
+import implicit_boundaries
+from shapes import fibonacci_sphere
+
+
+def open_scan():
+    """The unit sphere above z = -0.5: one boundary; outward normals."""
+    u = fibonacci_sphere(6000)
+    u = u[u[:, 2] > -0.5]
+    return u, u.copy()
+
+
+def rotation_about_z(degrees):
+    c, s = np.cos(np.radians(degrees)), np.sin(np.radians(degrees))
+    return np.array([[c, -s, 0], [s, c, 0], [0, 0, 1.0]])
+
+
+def test_the_surface_lies_where_the_layer_matrix_puts_the_scan(plugin):
+    """The layer's vertices stay put and its matrix turns the scan upside down and moves it:
+    the surface is made where the user sees the scan (before: where the raw vertices are, with
+    the boundary at the bottom instead of the top), and the new layer's matrix is the identity."""
+    points, normals = open_scan()
+    matrix = np.eye(4)
+    matrix[:3, :3] = rotation_about_z(30) @ np.diag([1.0, -1, -1])  # upside down, turned
+    matrix[:3, 3] = [5, -2, 1]
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=points, v_normals_matrix=normals), "scan")
+    ms.set_matrix(transformmatrix=matrix, freeze=False)
+    out = implicit_boundaries.apply(ms)
+    surface = ms.current_mesh()
+    np.testing.assert_allclose(surface.transform_matrix(), np.eye(4))
+    local = (surface.vertex_matrix() - matrix[:3, 3]) @ matrix[:3, :3]  # back to the scan's frame
+    spacing = out["sample_spacing"]
+    assert np.abs(np.linalg.norm(local, axis=1) - 1).max() < 0.5 * spacing
+    assert out["boundary_loops"] == 1
+    loop = surface.vertex_matrix()[np.asarray(out["boundary_loop_vertices"]).astype(int)]
+    assert np.abs(loop[:, 2] - (1 + 0.5)).max() < 2 * spacing  # z = -0.5 turned upside down, moved up 1
+    # Outward: the face normals point away from the moved centre.
+    faces = surface.face_matrix()
+    v = surface.vertex_matrix()
+    normal = np.cross(v[faces[:, 1]] - v[faces[:, 0]], v[faces[:, 2]] - v[faces[:, 0]])
+    assert (np.sum(normal * (v[faces].mean(axis=1) - matrix[:3, 3]), axis=1) > 0).mean() > 0.99
+
+
+def test_zero_normals_among_given_ones_are_estimated(plugin):
+    """11 of the layer's normals are zero and the others given (inward, as a scanner facing the
+    inside of a bowl would give them): the run no longer stops with "choose to estimate
+    normals"; the 11 are estimated facing like their neighbours, the given ones are kept (the
+    surface is inside out, as they say), and the log and result say how many."""
+    points, normals = open_scan()
+    normals = -normals
+    zero = np.arange(100, 1100, 91)[:11]
+    normals[zero] = 0
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=points, v_normals_matrix=normals), "scan")
+    out = implicit_boundaries.apply(ms)
+    assert out["normals_filled"] == 11 and not out["normals_estimated"]
+    assert out["boundary_loops"] == 1
+    m = ms.current_mesh()
+    v, faces = m.vertex_matrix(), m.face_matrix()
+    normal = np.cross(v[faces[:, 1]] - v[faces[:, 0]], v[faces[:, 2]] - v[faces[:, 0]])
+    assert (np.sum(normal * v[faces].mean(axis=1), axis=1) < 0).mean() > 0.999
