@@ -45,6 +45,39 @@ ib::Points vertexMatrix(const CMeshO& m, bool normals)
 	return out;
 }
 
+/// The layers whose vertices are the samples: every visible layer with vertices when merging
+/// (as Screened Poisson's "Merge all visible layers": several aligned range scans), else the
+/// current one.
+std::vector<const MeshModel*> inputLayers(const MeshDocument& md, bool merge)
+{
+	std::vector<const MeshModel*> layers;
+	if (!merge)
+		return {md.mm()};
+	for (const MeshModel& m : md.meshIterator())
+		if (m.isVisible() && m.cm.vn > 0)
+			layers.push_back(&m);
+	if (layers.empty())
+		throw MLException("No visible layer has vertices: show the scans to merge (the eye icon in the layer "
+						  "dialog), or turn off 'Merge visible layers' to use the current layer.");
+	return layers;
+}
+
+/// The vertices (normals = false) or normals of `layers`, one after the other, each through its
+/// own matrix.
+ib::Points stackedMatrix(const std::vector<const MeshModel*>& layers, bool normals)
+{
+	Eigen::Index rows = 0;
+	for (const MeshModel* m : layers)
+		rows += m->cm.vn;
+	ib::Points out(rows, 3);
+	Eigen::Index row = 0;
+	for (const MeshModel* m : layers) {
+		out.middleRows(row, m->cm.vn) = vertexMatrix(m->cm, normals);
+		row += m->cm.vn;
+	}
+	return out;
+}
+
 Eigen::VectorXd toVector(const std::vector<double>& v)
 {
 	return Eigen::Map<const Eigen::VectorXd>(v.data(), Eigen::Index(v.size()));
@@ -265,6 +298,11 @@ RichParameterList FilterImplicitBoundariesPlugin::reconstructionParameters(const
 		"the trim leaves.",
 		true));
 	par.addParam(RichBool(
+		"merge_visible_layers", false, "Merge visible layers",
+		"Reconstruct one surface from the vertices of every visible layer, each through its own "
+		"transformation matrix: several range scans aligned with the Align tool. Overlapping scans "
+		"are averaged by the implicit function. Off: the current layer only."));
+	par.addParam(RichBool(
 		"hole_layer", false, "Hole triangles in their own layer",
 		"Also add a layer '<input> holes' with the triangles that close the kept holes: showing "
 		"both layers gives the closed surface, hiding it the surface with boundaries."));
@@ -364,9 +402,10 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 
 	ib::CoreMesh surface, holes;
 	ib::Reconstruction::Result r;
-	const ib::Points positions = vertexMatrix(input->cm, false);
+	const std::vector<const MeshModel*> layers = inputLayers(md, par.getBool("merge_visible_layers"));
+	const ib::Points positions = stackedMatrix(layers, false);
 	try {
-		r = ib::Reconstruction::Compute(positions, vertexMatrix(input->cm, true), p, surface,
+		r = ib::Reconstruction::Compute(positions, stackedMatrix(layers, true), p, surface,
 										holeLayer ? &holes : nullptr, cb);
 	}
 	catch (const ib::InputError& e) {
@@ -387,8 +426,9 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 	// error never leaves a half-made layer in the user's document.
 	MeshModel* out = nullptr;
 	std::vector<unsigned int> added;
+	const QString label = layers.size() > 1 ? QString("Merged layers") : input->label();
 	try {
-		out = md.addNewMesh("", input->label() + " with boundaries", true);
+		out = md.addNewMesh("", label + " with boundaries", true);
 		added.push_back(out->id());
 		vcg::tri::Append<CMeshO, ib::CoreMesh>::MeshCopyConst(out->cm, surface);
 		vcg::tri::UpdateSelection<CMeshO>::VertexClear(out->cm);
@@ -397,13 +437,13 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 				out->cm.vert[v].SetS();
 		out->updateBoxAndNormals();
 		if (holeLayer) {
-			MeshModel* holeModel = md.addNewMesh("", input->label() + " holes", false);
+			MeshModel* holeModel = md.addNewMesh("", label + " holes", false);
 			added.push_back(holeModel->id());
 			vcg::tri::Append<CMeshO, ib::CoreMesh>::MeshCopyConst(holeModel->cm, holes);
 			holeModel->updateBoxAndNormals();
 		}
 		if (outlierLayer && !r.outliers.empty()) {
-			MeshModel* outlierModel = md.addNewMesh("", input->label() + " outliers", false);
+			MeshModel* outlierModel = md.addNewMesh("", label + " outliers", false);
 			added.push_back(outlierModel->id());
 			auto v = vcg::tri::Allocator<CMeshO>::AddVertices(outlierModel->cm, r.outliers.size());
 			for (Eigen::Index row : r.outliers)
@@ -427,6 +467,8 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 		loopVertices.insert(loopVertices.end(), loop.vertices.begin(), loop.vertices.end());
 	}
 
+	if (layers.size() > 1)
+		log("Merged %zu visible layers: %lld samples.", layers.size(), (long long)positions.rows());
 	if (r.duplicates_removed > 0)
 		log("Ignored %zu vertices at the same position as another one.", r.duplicates_removed);
 	if (!r.outliers.empty())

@@ -65,3 +65,30 @@ def test_zero_normals_among_given_ones_are_estimated(plugin):
     v, faces = m.vertex_matrix(), m.face_matrix()
     normal = np.cross(v[faces[:, 1]] - v[faces[:, 0]], v[faces[:, 2]] - v[faces[:, 0]])
     assert (np.sum(normal * v[faces].mean(axis=1), axis=1) < 0).mean() > 0.999
+
+
+def test_visible_layers_are_merged_each_through_its_matrix(plugin):
+    """A sphere scanned as two overlapping caps, the second stored in its scanner's frame with the
+    matrix that aligns it (as the Align tool leaves it), and a hidden layer of strays: merging
+    the visible layers gives the closed sphere, in a layer "Merged layers with boundaries";
+    the current layer alone gives its cap, with one loop."""
+    u = fibonacci_sphere(8000)
+    upper, lower = u[u[:, 2] > -0.2], u[u[:, 2] < 0.2]
+    matrix = np.eye(4)
+    matrix[:3, :3] = rotation_about_z(70)
+    matrix[:3, 3] = [0.5, 0, 0]
+    lower_local = (lower - matrix[:3, 3]) @ matrix[:3, :3]  # the inverse of the matrix
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=np.random.default_rng(0).uniform(-3, 3, (50, 3))), "strays")
+    ms.set_current_mesh_visibility(False)
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=lower_local, v_normals_matrix=lower_local), "lower")
+    ms.set_matrix(transformmatrix=matrix, freeze=False)
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=upper, v_normals_matrix=upper), "upper")
+    alone = implicit_boundaries.apply(ms)
+    assert alone["boundary_loops"] == 1
+    ms.set_current_mesh(2)
+    merged = implicit_boundaries.apply(ms, merge_visible_layers=True)
+    assert merged["boundary_loops"] == 0
+    assert ms.current_mesh().label() == "Merged layers with boundaries"
+    v = ms.current_mesh().vertex_matrix()
+    assert np.abs(np.linalg.norm(v, axis=1) - 1).max() < 0.5 * merged["sample_spacing"]
