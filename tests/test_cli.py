@@ -1,10 +1,12 @@
 """The command line, called in-process."""
 import re
 
+import numpy as np
 import pymeshlab
 import pytest
 
 from implicit_boundaries.cli import DEMO_SCAN, main
+from shapes import fibonacci_sphere
 from test_compare import two_holed_sphere
 
 
@@ -168,3 +170,52 @@ def test_viewpoint_orients_the_estimated_normals(tmp_path, capsys, plugin):
         a, b, c = (v[f[:, i]] for i in range(3))
         facing.append(np.mean(np.einsum("ij,ij->i", np.cross(b - a, c - a), a + b + c) > 0))
     assert facing[0] > 0.999 and facing[1] < 0.001
+
+
+def quaternion(axis, degrees):
+    """(qx, qy, qz, qw) of the rotation by `degrees` about the unit `axis`."""
+    half = np.radians(degrees) / 2
+    return (*(np.sin(half) * np.asarray(axis, dtype=float)), np.cos(half))
+
+
+@pytest.mark.parametrize("alignment", ["aln", "conf"])
+def test_scans_placed_by_an_alignment_file_are_merged(alignment, tmp_path, capsys, plugin):
+    """A sphere scanned as two overlapping caps, the lower one stored in its scanner's frame
+    (turned 90 degrees about x, moved), and an alignment file that places it (MeshLab's .aln: its
+    matrix; Stanford's .conf: translation and quaternion, world = R(q)^-1 p + t): one closed
+    sphere. Each cap alone has one loop."""
+    u = fibonacci_sphere(6000)
+    upper, lower = u[u[:, 2] > -0.2], u[u[:, 2] < 0.2]
+    t = np.array([0.3, -0.2, 0.1])
+    q = quaternion([1, 0, 0], 90)
+    rotation = np.array([[1.0, 0, 0], [0, 0, -1], [0, 1, 0]])  # R(q)
+    lower_local = (lower - t) @ rotation.T  # p = R (world - t)
+    for name, points in (("upper", upper), ("lower", lower_local)):
+        ms = pymeshlab.MeshSet()
+        normals = upper if name == "upper" else lower @ rotation.T  # outward, turned with the points
+        ms.add_mesh(pymeshlab.Mesh(vertex_matrix=points, v_normals_matrix=normals))
+        ms.save_current_mesh(str(tmp_path / f"{name}.ply"))
+    if alignment == "aln":
+        world = np.eye(4)
+        world[:3, :3], world[:3, 3] = rotation.T, t
+        rows = lambda m: "\n".join(" ".join(f"{x:.17g}" for x in row) for row in m)
+        text = f"2\nupper.ply\n#\n{rows(np.eye(4))}\nlower.ply\n#\n{rows(world)}\n0\n"
+    else:
+        text = ("camera 0 0 0 0 0 0 1\nbmesh upper.ply 0 0 0 0 0 0 1\n"
+                f"bmesh lower.ply {t[0]} {t[1]} {t[2]} {q[0]} {q[1]} {q[2]} {q[3]}\n")
+    (tmp_path / f"scans.{alignment}").write_text(text)
+    out = tmp_path / "merged.ply"
+    assert main(["reconstruct", str(tmp_path / f"scans.{alignment}"), "-o", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert "merging 2 scans" in printed and "0 boundary loops kept" in printed
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(str(out))
+    assert np.abs(np.linalg.norm(ms.current_mesh().vertex_matrix(), axis=1) - 1).max() < 0.02
+    assert main(["reconstruct", str(tmp_path / "upper.ply"), "-o", str(out)]) == 0
+    assert "1 boundary loops kept" in capsys.readouterr().out
+
+
+def test_a_broken_alignment_file_is_one_line(tmp_path, capsys):
+    (tmp_path / "scans.aln").write_text("2\nupper.ply\n#\n1 0 0\n")
+    assert main(["reconstruct", str(tmp_path / "scans.aln"), "-o", str(tmp_path / "out.ply")]) == 1
+    assert "not a MeshLab alignment" in one_error_line(capsys)

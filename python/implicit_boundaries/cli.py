@@ -1,6 +1,7 @@
 """Command line: ``implicit-boundaries`` (or ``python -m implicit_boundaries``).
 
-Subcommands: ``reconstruct IN -o OUT`` (any format pymeshlab reads and writes), ``compare IN
+Subcommands: ``reconstruct IN [IN ...] -o OUT`` (any format pymeshlab reads and writes;
+several scans, or an ``.aln``/``.conf`` alignment, give one merged surface), ``compare IN
 [--truth GT] --report DIR`` (side by side with MeshLab's screened Poisson), ``demo``
 (pymeshlab's bunny scan with its holes, reconstructed and compared) and ``info`` (versions,
 plugin path, whether it loads). Errors are one line on stderr and exit status 1; ``--verbose``
@@ -15,20 +16,38 @@ import numpy as np
 import pymeshlab
 
 from ._plugin import FILTER_NAME, apply, load
+from .alignment import read_alignment
 from .compare import compare
 from .reconstruct import loops_from_result
 
 DEMO_SCAN = Path(pymeshlab.__file__).parent / "tests" / "sample_meshes" / "bunny10k_textured.obj"
 
 
-def _point_cloud(ms: pymeshlab.MeshSet, path: Path) -> None:
-    """Loads `path` and replaces it by its vertices and normals only (faces ignored)."""
-    ms.load_new_mesh(str(path))
-    m = ms.current_mesh()
+def _point_cloud(ms: pymeshlab.MeshSet, path: Path, matrix=None) -> None:
+    """Adds a layer with the vertices and normals of `path` (faces ignored), with `matrix` (4x4,
+    taking the scan to the common frame) as its transformation matrix."""
+    if not path.is_file():
+        raise FileNotFoundError(f"{path}: no such file")
+    scan = pymeshlab.MeshSet()
+    scan.load_new_mesh(str(path))
+    m = scan.current_mesh()
     m.compact()
-    points = pymeshlab.Mesh(vertex_matrix=m.vertex_matrix(), v_normals_matrix=m.vertex_normal_matrix())
-    ms.clear()
-    ms.add_mesh(points, path.stem)
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=m.vertex_matrix(), v_normals_matrix=m.vertex_normal_matrix()), path.stem)
+    if matrix is not None:
+        ms.set_matrix(transformmatrix=np.asarray(matrix, dtype=np.float64), freeze=False)
+
+
+def _scans(inputs) -> list:
+    """[(path, matrix or None)] of the command line's inputs: scan files, and alignment files
+    (.aln, .conf) standing for the scans they list, with their matrices."""
+    scans = []
+    for name in inputs:
+        path = Path(name)
+        if path.suffix.lower() in (".aln", ".conf"):
+            scans += read_alignment(path)
+        else:
+            scans.append((path, None))
+    return scans
 
 
 class ProgressBar:
@@ -71,9 +90,9 @@ def _filter_params(args) -> dict:
     return params
 
 
-def _reconstruct(ms: pymeshlab.MeshSet, args) -> dict:
+def _reconstruct(ms: pymeshlab.MeshSet, args, **params) -> dict:
     load()
-    params = _filter_params(args)
+    params.update(_filter_params(args))
     if args.resolution is not None:
         params["resolution"] = args.resolution
     return apply(ms, **params)
@@ -94,11 +113,12 @@ def _report(result: dict, out: Path, viewpoint=None) -> None:
 
 def cmd_reconstruct(args) -> int:
     ms = pymeshlab.MeshSet()
-    path = Path(args.input)
-    if not path.is_file():
-        raise FileNotFoundError(f"{path}: no such file")
-    _point_cloud(ms, path)
-    result = _reconstruct(ms, args)
+    scans = _scans(args.input)
+    for path, matrix in scans:
+        _point_cloud(ms, path, matrix)
+    if len(scans) > 1:
+        print(f"merging {len(scans)} scans, {sum(ms.mesh(i).vertex_number() for i in range(len(scans)))} samples")
+    result = _reconstruct(ms, args, merge_visible_layers=len(scans) > 1)
     out = Path(args.output)
     out.parent.mkdir(parents=True, exist_ok=True)
     ms.save_current_mesh(str(out))
@@ -123,7 +143,7 @@ def cmd_compare(args) -> int:
 
 def cmd_demo(args) -> int:
     print(f"input: vertices and normals of {DEMO_SCAN} (pymeshlab's Stanford bunny, 5 holes at its base)")
-    args.input = DEMO_SCAN
+    args.input = [DEMO_SCAN]
     cmd_reconstruct(args)
     print("comparing with MeshLab's screened Poisson, the scan's own mesh as ground truth")
     return _compare(args, DEMO_SCAN, DEMO_SCAN)
@@ -164,8 +184,10 @@ def _parser() -> argparse.ArgumentParser:
         q.add_argument("--viewpoint", type=float, nargs=3, metavar=("X", "Y", "Z"),
                        help="estimate normals facing this scanner position (one range scan)")
 
-    r = sub.add_parser("reconstruct", help="reconstruct a point cloud file into a mesh file")
-    r.add_argument("input")
+    r = sub.add_parser("reconstruct", help="reconstruct point cloud files into a mesh file")
+    r.add_argument("input", nargs="+",
+                   help="a scan, or several (merged into one surface), or a MeshLab .aln / Stanford .conf "
+                        "alignment standing for the scans it lists, each placed by its matrix")
     r.add_argument("-o", "--output", required=True)
     options(r)
     r.set_defaults(run=cmd_reconstruct)

@@ -1,0 +1,68 @@
+"""Alignment files that place several range scans in one frame: MeshLab's ``.aln`` (written by
+its Align tool) and the Stanford ``.conf``. Each gives, per scan, its file and the 4x4 matrix M
+that takes the scan's points p to the common frame (M @ [p, 1]), the layer matrix MeshLab
+would give it."""
+from pathlib import Path
+
+import numpy as np
+
+
+def read_alignment(path) -> list:
+    """[(scan path, (4, 4) matrix)] from a ``.aln`` or ``.conf`` file; scan paths are relative to
+    the alignment file's folder. Raises ValueError with the line at fault."""
+    path = Path(path)
+    text = path.read_text().splitlines()
+    if path.suffix.lower() == ".conf":
+        scans = _conf(text, path)
+    elif path.suffix.lower() == ".aln":
+        scans = _aln(text, path)
+    else:
+        raise ValueError(f"{path}: not an alignment file (MeshLab .aln or Stanford .conf)")
+    if not scans:
+        raise ValueError(f"{path}: lists no scans")
+    return [(path.parent / name, matrix) for name, matrix in scans]
+
+
+def _conf(lines, path):
+    """Stanford: ``bmesh FILE tx ty tz qx qy qz qw`` means world = R(q)^-1 p + t."""
+    scans = []
+    for number, line in enumerate(lines, 1):
+        words = line.split()
+        if not words or words[0] != "bmesh":
+            continue  # camera, comments
+        try:
+            t = np.array(words[2:5], dtype=float)
+            qx, qy, qz, qw = (float(w) for w in words[5:9])
+        except ValueError:
+            raise ValueError(f"{path}:{number}: expected 'bmesh FILE tx ty tz qx qy qz qw'") from None
+        if len(words) != 9:
+            raise ValueError(f"{path}:{number}: expected 'bmesh FILE tx ty tz qx qy qz qw'")
+        norm = np.sqrt(qx * qx + qy * qy + qz * qz + qw * qw)
+        qx, qy, qz, qw = qx / norm, qy / norm, qz / norm, qw / norm
+        rotation = np.array([
+            [1 - 2 * (qy * qy + qz * qz), 2 * (qx * qy - qz * qw), 2 * (qx * qz + qy * qw)],
+            [2 * (qx * qy + qz * qw), 1 - 2 * (qx * qx + qz * qz), 2 * (qy * qz - qx * qw)],
+            [2 * (qx * qz - qy * qw), 2 * (qy * qz + qx * qw), 1 - 2 * (qx * qx + qy * qy)]])
+        matrix = np.eye(4)
+        matrix[:3, :3] = rotation.T  # the inverse of a rotation
+        matrix[:3, 3] = t
+        scans.append((words[1], matrix))
+    return scans
+
+
+def _aln(lines, path):
+    """MeshLab: the scan count, then per scan its file, a '#' line and 4 rows of its matrix."""
+    lines = [line.strip() for line in lines if line.strip()]
+    try:
+        count = int(lines[0])
+        scans = []
+        for i in range(count):
+            block = lines[1 + 6 * i: 7 + 6 * i]
+            matrix = np.array([[float(x) for x in row.split()] for row in block[2:6]])
+            if matrix.shape != (4, 4):
+                raise ValueError
+            scans.append((block[0], matrix))
+    except (ValueError, IndexError):
+        raise ValueError(f"{path}: not a MeshLab alignment: a scan count, then per scan its file, '#' and "
+                         "4 rows of 4 numbers") from None
+    return scans
