@@ -404,6 +404,9 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 	ib::Reconstruction::Result r;
 	const std::vector<const MeshModel*> layers = inputLayers(md, par.getBool("merge_visible_layers"));
 	const ib::Points positions = stackedMatrix(layers, false);
+	if (layers.size() > 1)
+		for (const MeshModel* m : layers)
+			p.scan_sizes.push_back(m->cm.vn);
 	try {
 		r = ib::Reconstruction::Compute(positions, stackedMatrix(layers, true), p, surface,
 										holeLayer ? &holes : nullptr, cb);

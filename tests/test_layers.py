@@ -3,6 +3,7 @@ and "Set matrix" change) and layers whose normals are only partly given (MeshLab
 range scan leaves zero normals on grid points no triangle uses)."""
 import numpy as np
 import pymeshlab
+import pytest
 
 import implicit_boundaries
 from shapes import fibonacci_sphere
@@ -92,3 +93,29 @@ def test_visible_layers_are_merged_each_through_its_matrix(plugin):
     assert ms.current_mesh().label() == "Merged layers with boundaries"
     v = ms.current_mesh().vertex_matrix()
     assert np.abs(np.linalg.norm(v, axis=1) - 1).max() < 0.5 * merged["sample_spacing"]
+
+
+@pytest.mark.parametrize("seed", [3, 4])
+def test_overlapping_scans_with_registration_error_give_one_sheet(plugin, seed):
+    """An open cap (the unit sphere above z = -0.5) scanned from four sides, each scan a
+    hemisphere sampled on its own and overlapping its neighbours, registered with an error of
+    0.8 of a scan's spacing (a shift, as the Align tool leaves between scans). Merged, the
+    density grows but the detail does not: the spacing is measured within each scan, and the
+    surface is one sheet with the cap's one loop (measured over all samples, the sheets lay
+    apart by more than a spacing and tore: 4 and 12 loops)."""
+    rng = np.random.default_rng(seed)
+    spacing = np.sqrt(4 * np.pi / 5000)
+    ms = pymeshlab.MeshSet()
+    for i, side in enumerate([[1, 0, 0.3], [-0.5, 0.87, 0.3], [-0.5, -0.87, 0.3], [0, 0, 1]]):
+        u = fibonacci_sphere(5000, jitter=0.3, rng=rng)
+        u = u[(u[:, 2] > -0.5) & (u @ side > 0)]
+        shift = rng.normal(size=3)
+        matrix = np.eye(4)
+        matrix[:3, 3] = 0.8 * spacing * shift / np.linalg.norm(shift)
+        ms.add_mesh(pymeshlab.Mesh(vertex_matrix=u, v_normals_matrix=u), f"scan {i}")
+        ms.set_matrix(transformmatrix=matrix, freeze=False)
+    out = implicit_boundaries.apply(ms, merge_visible_layers=True)
+    assert out["boundary_loops"] == 1
+    assert abs(out["sample_spacing"] - spacing) < 0.2 * spacing
+    radius = np.linalg.norm(ms.current_mesh().vertex_matrix(), axis=1)
+    assert np.quantile(np.abs(radius - 1), 0.99) < spacing  # between the sheets, up to their rims
