@@ -91,6 +91,17 @@ QString loopSummary(const std::vector<ib::BoundaryLoop>& loops)
 	return loops.empty() ? QString("none") : sizes.join(", ");
 }
 
+/// The layer offered as the implicit mesh: the most recent layer with faces other than the
+/// current one (the output of Screened Poisson run on the points), else the current one.
+unsigned int defaultImplicitMesh(const MeshDocument& md)
+{
+	unsigned int id = md.mm() ? md.mm()->id() : 0;
+	for (const MeshModel& m : md.meshIterator())
+		if (m.cm.fn > 0 && &m != md.mm())
+			id = m.id();
+	return id;
+}
+
 /// The signed distance to the mesh layer `id`, or an MLException saying why it cannot be one.
 std::unique_ptr<ib::MeshDistance> implicitMesh(MeshDocument& md, unsigned int id)
 {
@@ -229,7 +240,7 @@ RichParameterList FilterImplicitBoundariesPlugin::reconstructionParameters(const
 		"no fitting, follows noise more closely. 'Mesh layer (signed distance)': the closed mesh "
 		"chosen below, e.g. the output of Screened Poisson, gets the scan's real boundaries."));
 	par.addParam(RichMesh(
-		"implicit_mesh", md.mm() ? md.mm()->id() : 0, &md, "Implicit mesh layer",
+		"implicit_mesh", defaultImplicitMesh(md), &md, "Implicit mesh layer",
 		"With 'Mesh layer (signed distance)': the closed triangle mesh whose surface is extracted "
 		"where the point layer has samples (run Screened Poisson on the points first). Ignored "
 		"by the other implicit functions."));

@@ -205,7 +205,11 @@ def test_scans_placed_by_an_alignment_file_are_merged(alignment, tmp_path, capsy
                 f"bmesh lower.ply {t[0]} {t[1]} {t[2]} {q[0]} {q[1]} {q[2]} {q[3]}\n")
     (tmp_path / f"scans.{alignment}").write_text(text)
     out = tmp_path / "merged.ply"
-    assert main(["reconstruct", str(tmp_path / f"scans.{alignment}"), "-o", str(out)]) == 0
+    if alignment == "aln":  # the alignment file stands for its scans
+        assert main(["reconstruct", str(tmp_path / f"scans.{alignment}"), "-o", str(out)]) == 0
+    else:  # the scans, placed by the alignment file
+        assert main(["reconstruct", str(tmp_path / "upper.ply"), str(tmp_path / "lower.ply"),
+                     "--alignment", str(tmp_path / f"scans.{alignment}"), "-o", str(out)]) == 0
     printed = capsys.readouterr().out
     assert "merging 2 scans" in printed and "0 boundary loops kept" in printed
     ms = pymeshlab.MeshSet()
@@ -219,3 +223,17 @@ def test_a_broken_alignment_file_is_one_line(tmp_path, capsys):
     (tmp_path / "scans.aln").write_text("2\nupper.ply\n#\n1 0 0\n")
     assert main(["reconstruct", str(tmp_path / "scans.aln"), "-o", str(tmp_path / "out.ply")]) == 1
     assert "not a MeshLab alignment" in one_error_line(capsys)
+
+
+def test_a_scan_missing_from_the_alignment_is_one_line(tmp_path, capsys):
+    (tmp_path / "scans.conf").write_text("bmesh upper.ply 0 0 0 0 0 0 1\n")
+    (tmp_path / "other.ply").write_text("")
+    assert main(["reconstruct", str(tmp_path / "other.ply"), "--alignment", str(tmp_path / "scans.conf"),
+                 "-o", str(tmp_path / "out.ply")]) == 1
+    assert "other.ply is not in" in one_error_line(capsys)
+
+
+def test_a_listed_scan_that_is_missing_is_one_line(tmp_path, capsys):
+    (tmp_path / "scans.conf").write_text("bmesh upper.ply 0 0 0 0 0 0 1\n")
+    assert main(["reconstruct", str(tmp_path / "scans.conf"), "-o", str(tmp_path / "out.ply")]) == 1
+    assert "upper.ply: no such file" in one_error_line(capsys)

@@ -52,3 +52,14 @@ def test_mesh_implicit_needs_a_layer_with_faces(hemisphere):
     with pytest.raises(pymeshlab.PyMeshLabException, match="has no faces"):
         implicit_boundaries.apply(ms, implicit=MESH_IMPLICIT, implicit_mesh=0)
     assert ms.mesh_number() == 1
+
+
+def test_the_mesh_implicit_defaults_to_the_layer_poisson_made(hemisphere):
+    """After Screened Poisson on the points, with the points layer current again, the mesh
+    implicit needs no layer chosen: it defaults to the most recent layer with faces."""
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=hemisphere, v_normals_matrix=hemisphere), "hemisphere")
+    ms.generate_surface_reconstruction_screened_poisson(depth=7)
+    ms.set_current_mesh(0)
+    info = implicit_boundaries.apply(ms, implicit=MESH_IMPLICIT)
+    assert info["boundary_loops"] == 1 and ms.mesh_number() == 3

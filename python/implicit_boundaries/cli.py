@@ -37,14 +37,20 @@ def _point_cloud(ms: pymeshlab.MeshSet, path: Path, matrix=None) -> None:
         ms.set_matrix(transformmatrix=np.asarray(matrix, dtype=np.float64), freeze=False)
 
 
-def _scans(inputs) -> list:
+def _scans(inputs, alignment=None) -> list:
     """[(path, matrix or None)] of the command line's inputs: scan files, and alignment files
-    (.aln, .conf) standing for the scans they list, with their matrices."""
+    (.aln, .conf) standing for the scans they list, with their matrices. With `alignment`, each
+    scan file gets the matrix that file gives it (matched by file name)."""
+    placed = {path.name: matrix for path, matrix in read_alignment(alignment)} if alignment else None
     scans = []
     for name in inputs:
         path = Path(name)
         if path.suffix.lower() in (".aln", ".conf"):
             scans += read_alignment(path)
+        elif placed is not None:
+            if path.name not in placed:
+                raise ValueError(f"{path.name} is not in {alignment}: it lists {', '.join(sorted(placed))}")
+            scans.append((path, placed[path.name]))
         else:
             scans.append((path, None))
     return scans
@@ -113,7 +119,7 @@ def _report(result: dict, out: Path, viewpoint=None) -> None:
 
 def cmd_reconstruct(args) -> int:
     ms = pymeshlab.MeshSet()
-    scans = _scans(args.input)
+    scans = _scans(args.input, getattr(args, "alignment", None))  # demo has none
     for path, matrix in scans:
         _point_cloud(ms, path, matrix)
     if len(scans) > 1:
@@ -188,6 +194,8 @@ def _parser() -> argparse.ArgumentParser:
     r.add_argument("input", nargs="+",
                    help="a scan, or several (merged into one surface), or a MeshLab .aln / Stanford .conf "
                         "alignment standing for the scans it lists, each placed by its matrix")
+    r.add_argument("--alignment", metavar="FILE",
+                   help="a MeshLab .aln or Stanford .conf file that places the scans given (by file name)")
     r.add_argument("-o", "--output", required=True)
     options(r)
     r.set_defaults(run=cmd_reconstruct)
