@@ -119,3 +119,26 @@ def test_overlapping_scans_with_registration_error_give_one_sheet(plugin, seed):
     assert abs(out["sample_spacing"] - spacing) < 0.2 * spacing
     radius = np.linalg.norm(ms.current_mesh().vertex_matrix(), axis=1)
     assert np.quantile(np.abs(radius - 1), 0.99) < spacing  # between the sheets, up to their rims
+
+
+def test_turned_normals_at_one_scans_border_do_not_cut_the_merged_surface(plugin):
+    """Two overlapping scans of a cap; towards its border, where it sees the surface at a
+    grazing angle, the second scan's normals turn steadily away from the true ones, up to 140
+    degrees at its edge (consistent within the scan). Neighbouring samples of different scans
+    with opposite normals are not an orientation seam (a registration error cannot flip a
+    normal): the merged surface keeps the cap's one loop, not cut there (the same samples in one
+    layer: cut, 3 loops)."""
+    rng = np.random.default_rng(0)
+    first, second = (fibonacci_sphere(8000, jitter=0.3, rng=rng) for _ in range(2))  # sampled apart
+    first = first[(first[:, 2] > -0.5) & (first[:, 0] > -0.2)]
+    second = second[(second[:, 2] > -0.5) & (second[:, 0] < 0.2)]
+    toward_edge = np.array([1.0, 0, 0]) - second[:, [0]] * second  # tangent, towards +x
+    toward_edge /= np.linalg.norm(toward_edge, axis=1, keepdims=True)
+    turn = np.radians(140) * np.clip((second[:, [0]] - 0.05) / 0.15, 0, 1)
+    normals = np.cos(turn) * second + np.sin(turn) * toward_edge
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=first, v_normals_matrix=first), "first")
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=second, v_normals_matrix=normals), "second")
+    out = implicit_boundaries.apply(ms, merge_visible_layers=True)
+    assert out["seam_points"] == 0
+    assert out["boundary_loops"] == 1

@@ -272,7 +272,8 @@ private:
 
         t = Clock::now();
         if (cb) cb(5, "Building the implicit function");
-        const Eigen::VectorXd spacing = ScanSpacing(samples, ScanOf(p.scan_sizes, input.rows(), kept), p.threads);
+        const std::vector<int> scan = ScanOf(p.scan_sizes, input.rows(), kept);
+        const Eigen::VectorXd spacing = ScanSpacing(samples, scan, p.threads);
         r.sample_spacing = SampleSpacing::Median(spacing);
         const std::unique_ptr<ImplicitFunction> fitted =
             p.implicit == Implicit::Given ? nullptr : MakeImplicit(P, normals, samples, p, cb);
@@ -331,7 +332,7 @@ private:
 
         t = Clock::now();
         if (cb) cb(97, "Tracing boundary loops, filling small holes");
-        const Points seam = OrientationSeam::Find(samples, normals, spacing, p.threads);
+        const Points seam = OrientationSeam::Find(samples, normals, spacing, p.threads, scan);
         r.seam_points = size_t(seam.rows());
         const std::vector<char> inSurface =
             Boundaries(surface, mc, samples, spacing, seam, f, lattice.cell_size, p, r);
