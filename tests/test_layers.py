@@ -142,3 +142,18 @@ def test_turned_normals_at_one_scans_border_do_not_cut_the_merged_surface(plugin
     out = implicit_boundaries.apply(ms, merge_visible_layers=True)
     assert out["seam_points"] == 0
     assert out["boundary_loops"] == 1
+
+
+def test_reconstruct_scans_from_arrays(plugin):
+    """The Python API for several scans: (points, normals, matrix) per scan, the second stored
+    in its scanner's frame; one closed sphere. A scan whose normals do not match is refused."""
+    u = fibonacci_sphere(6000)
+    upper, lower = u[u[:, 2] > -0.2], u[u[:, 2] < 0.2]
+    matrix = np.eye(4)
+    matrix[:3, :3] = rotation_about_z(40)
+    lower_local = lower @ matrix[:3, :3]  # the inverse rotation
+    rec = implicit_boundaries.reconstruct_scans([(upper, upper), (lower_local, lower_local, matrix)])
+    assert rec.loops == [] and rec.info["boundary_loops"] == 0
+    assert np.abs(np.linalg.norm(rec.vertices, axis=1) - 1).max() < 0.5 * rec.info["sample_spacing"]
+    with pytest.raises(ValueError, match="scan 1: normals"):
+        implicit_boundaries.reconstruct_scans([(upper, upper), (lower, lower[:5])])

@@ -67,3 +67,31 @@ def reconstruct(points, normals: Optional[np.ndarray] = None, estimate_normals: 
     info = apply(ms, **params)
     out = ms.current_mesh()
     return Reconstruction(out.vertex_matrix(), out.face_matrix(), loops_from_result(info), dict(info))
+
+
+def reconstruct_scans(scans, **params) -> Reconstruction:
+    """One surface with boundaries from several range scans, as the filter's "merge visible
+    layers" makes it: ``scans`` is a list of (points, normals) or (points, normals, matrix), with
+    (n_i, 3) points, (n_i, 3) normals or None (estimated), and a (4, 4) matrix that takes the
+    scan to the common frame (identity when left out; e.g. from
+    :func:`implicit_boundaries.alignment.read_alignment`). Sample spacing is measured within
+    each scan. params: as :func:`reconstruct`."""
+    load()
+    ms = pymeshlab.MeshSet()
+    for i, scan in enumerate(scans):
+        points = np.ascontiguousarray(scan[0], dtype=np.float64).reshape(-1, 3)
+        normals = scan[1] if len(scan) > 1 else None
+        if normals is None:
+            ms.add_mesh(pymeshlab.Mesh(vertex_matrix=points), f"scan {i}")
+        else:
+            normals = np.ascontiguousarray(normals, dtype=np.float64).reshape(-1, 3)
+            if normals.shape != points.shape:
+                raise ValueError(f"scan {i}: normals have shape {normals.shape}, points {points.shape}")
+            ms.add_mesh(pymeshlab.Mesh(vertex_matrix=points, v_normals_matrix=normals), f"scan {i}")
+        if len(scan) > 2 and scan[2] is not None:
+            ms.set_matrix(transformmatrix=np.asarray(scan[2], dtype=np.float64).reshape(4, 4), freeze=False)
+    if not len(ms):
+        raise ValueError("no scans given")
+    info = apply(ms, merge_visible_layers=True, **params)
+    out = ms.current_mesh()
+    return Reconstruction(out.vertex_matrix(), out.face_matrix(), loops_from_result(info), dict(info))
