@@ -363,10 +363,12 @@ public:
     }
 
     /// Per sample of `kept` (rows of an input of `rows` rows), the index of its scan given the
-    /// scans' sizes (empty: every sample in scan 0).
+    /// scans' sizes; empty for a single scan.
     static std::vector<int> ScanOf(const std::vector<Eigen::Index>& sizes, Eigen::Index rows,
                                    const std::vector<Eigen::Index>& kept)
     {
+        if (sizes.size() <= 1)
+            return {};
         std::vector<int> scanOfRow(size_t(rows), 0);
         Eigen::Index row = 0;
         for (size_t s = 0; s < sizes.size(); ++s)
@@ -380,22 +382,26 @@ public:
     }
 
     /// Local sample spacing, measured among the samples of each sample's own scan (`scan`: the
-    /// scan index per sample). A scan too small to measure keeps the spacing among all samples.
+    /// scan index per sample, empty for one scan). The samples of a scan too small to measure
+    /// get the spacing among all samples.
     static Eigen::VectorXd ScanSpacing(const SampleIndex& samples, const std::vector<int>& scan, int threads)
     {
-        Eigen::VectorXd spacing = SampleSpacing::Local(samples, 1, threads);
-        const int scans = scan.empty() ? 1 : *std::max_element(scan.begin(), scan.end()) + 1;
-        for (int s = 0; s < scans && scans > 1; ++s) {
-            std::vector<Eigen::Index> rows;
-            for (size_t i = 0; i < scan.size(); ++i)
-                if (scan[i] == s)
-                    rows.push_back(Eigen::Index(i));
-            if (rows.size() <= size_t(SampleSpacing::kNeighbours))
+        if (scan.empty())
+            return SampleSpacing::Local(samples, 1, threads);
+        std::vector<std::vector<Eigen::Index>> rows(size_t(*std::max_element(scan.begin(), scan.end()) + 1));
+        for (size_t i = 0; i < scan.size(); ++i)
+            rows[size_t(scan[i])].push_back(Eigen::Index(i));
+        Eigen::VectorXd spacing(samples.Size());
+        std::vector<Eigen::Index> unmeasured;
+        for (const std::vector<Eigen::Index>& own : rows) {
+            if (own.size() <= size_t(SampleSpacing::kNeighbours)) {
+                unmeasured.insert(unmeasured.end(), own.begin(), own.end());
                 continue;
-            const Eigen::VectorXd own = SampleSpacing::Local(SampleIndex(samples.P()(rows, Eigen::all)), 1, threads);
-            for (size_t i = 0; i < rows.size(); ++i)
-                spacing[rows[i]] = own[Eigen::Index(i)];
+            }
+            spacing(own) = SampleSpacing::Local(SampleIndex(samples.P()(own, Eigen::all)), 1, threads);
         }
+        if (!unmeasured.empty())
+            spacing(unmeasured) = SampleSpacing::Local(samples, 1, threads)(unmeasured);
         return spacing;
     }
 
