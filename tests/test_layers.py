@@ -157,3 +157,45 @@ def test_reconstruct_scans_from_arrays(plugin):
     assert np.abs(np.linalg.norm(rec.vertices, axis=1) - 1).max() < 0.5 * rec.info["sample_spacing"]
     with pytest.raises(ValueError, match="scan 1: normals"):
         implicit_boundaries.reconstruct_scans([(upper, upper), (lower, lower[:5])])
+
+
+def height(x, y):
+    """The known surface of the two-scan test: a wavy sheet z = height(x, y)."""
+    return 0.1 * np.sin(3 * x) * np.cos(2 * y)
+
+
+def strip_scan(x_range, spacing, rng):
+    """Jittered grid samples of the wavy sheet over x_range × [-1, 1], with their normals."""
+    x, y = np.meshgrid(np.arange(x_range[0], x_range[1], spacing), np.arange(-1, 1, spacing))
+    x = x.ravel() + rng.uniform(-0.3, 0.3, x.size) * spacing
+    y = y.ravel() + rng.uniform(-0.3, 0.3, y.size) * spacing
+    normals = np.column_stack([-0.3 * np.cos(3 * x) * np.cos(2 * y), 0.2 * np.sin(3 * x) * np.sin(2 * y), np.ones_like(x)])
+    return np.column_stack([x, y, height(x, y)]), normals / np.linalg.norm(normals, axis=1, keepdims=True)
+
+
+def test_two_scans_offset_and_turned_give_one_sheet(plugin):
+    """Two overlapping scans of a wavy sheet (x < 0.3 and x > -0.3), the second registered with
+    an error: moved 0.5 of a spacing along the normal and turned 0.2 degrees. Merged: one sheet
+    (the area of the truth, not the 1.3 times a doubled overlap would have), the sheet's one
+    loop and no slit where the scans overlap, and every vertex within a spacing of the truth."""
+    spacing = 0.02
+    rng = np.random.default_rng(1)
+    first, first_normals = strip_scan((-1, 0.3), spacing, rng)
+    second, second_normals = strip_scan((-0.3, 1), spacing, rng)
+    turn = np.radians(0.2)
+    matrix = np.eye(4)
+    matrix[:3, :3] = [[np.cos(turn), 0, np.sin(turn)], [0, 1, 0], [-np.sin(turn), 0, np.cos(turn)]]
+    matrix[:3, 3] = [0, 0, 0.5 * spacing]
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=first, v_normals_matrix=first_normals), "first")
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=second, v_normals_matrix=second_normals), "second")
+    ms.set_matrix(transformmatrix=matrix, freeze=False)
+    out = implicit_boundaries.apply(ms, merge_visible_layers=True)
+    assert out["boundary_loops"] == 1
+    v, f = ms.current_mesh().vertex_matrix(), ms.current_mesh().face_matrix()
+    assert np.abs(v[:, 2] - height(v[:, 0], v[:, 1])).max() < spacing  # vertical: at least the distance
+    area = 0.5 * np.linalg.norm(np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]]), axis=1).sum()
+    x, y = np.meshgrid(np.linspace(-1, 1, 401), np.linspace(-1, 1, 401))
+    gx, gy = 0.3 * np.cos(3 * x) * np.cos(2 * y), -0.2 * np.sin(3 * x) * np.sin(2 * y)
+    truth = 4 * np.mean(np.sqrt(1 + gx ** 2 + gy ** 2))
+    assert abs(area / truth - 1) < 0.05
