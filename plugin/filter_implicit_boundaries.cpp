@@ -45,6 +45,26 @@ ib::Points vertexMatrix(const CMeshO& m, bool normals)
 	return out;
 }
 
+/// Refuses a layer whose transformation matrix is not affine (a last row other than 0 0 0 1:
+/// MeshLab would divide by it, vertexMatrix does not) or collapses space (no inverse for the
+/// normals). Scales and shears are fine: positions and normals both follow them.
+void checkMatrix(const MeshModel& m)
+{
+	const Matrix44m& tr = m.cm.Tr;
+	Eigen::Matrix3d linear;
+	for (int i = 0; i < 3; ++i)
+		for (int j = 0; j < 3; ++j)
+			linear(i, j) = double(tr.ElementAt(i, j));
+	const bool affine = tr.ElementAt(3, 0) == 0 && tr.ElementAt(3, 1) == 0 && tr.ElementAt(3, 2) == 0 &&
+						tr.ElementAt(3, 3) == 1;
+	const double scale = linear.norm();
+	if (!affine || !linear.allFinite() || !(std::abs(linear.determinant()) > 1e-12 * scale * scale * scale))
+		throw MLException(QString("The transformation matrix of layer '%1' is not affine or cannot be inverted (it projects, or "
+								  "flattens the layer): set a valid one (Filters > Normals, Curvatures and "
+								  "Orientation > Matrix: Set/Copy Transformation, or Matrix: Reset Current Matrix).")
+							  .arg(m.label()));
+}
+
 /// The layers whose vertices are the samples: every visible layer with vertices when merging
 /// (as Screened Poisson's "Merge all visible layers": several aligned range scans), else the
 /// current one.
@@ -52,13 +72,16 @@ std::vector<const MeshModel*> inputLayers(const MeshDocument& md, bool merge)
 {
 	std::vector<const MeshModel*> layers;
 	if (!merge)
-		return {md.mm()};
-	for (const MeshModel& m : md.meshIterator())
-		if (m.isVisible() && m.cm.vn > 0)
-			layers.push_back(&m);
+		layers.push_back(md.mm());
+	else
+		for (const MeshModel& m : md.meshIterator())
+			if (m.isVisible() && m.cm.vn > 0)
+				layers.push_back(&m);
 	if (layers.empty())
 		throw MLException("No visible layer has vertices: show the scans to merge (the eye icon in the layer "
 						  "dialog), or turn off 'Merge visible layers' to use the current layer.");
+	for (const MeshModel* m : layers)
+		checkMatrix(*m);
 	return layers;
 }
 

@@ -237,3 +237,23 @@ def test_a_listed_scan_that_is_missing_is_one_line(tmp_path, capsys):
     (tmp_path / "scans.conf").write_text("bmesh upper.ply 0 0 0 0 0 0 1\n")
     assert main(["reconstruct", str(tmp_path / "scans.conf"), "-o", str(tmp_path / "out.ply")]) == 1
     assert "upper.ply: no such file" in one_error_line(capsys)
+
+
+@pytest.mark.parametrize("matrix, message", [
+    ("1 0 0 0\n0 1 0 0\n0 0 1 0\n0.3 -0.2 0.1 1", "last row is 0.3 -0.2 0.1 1, not 0 0 0 1"),  # written transposed
+    ("2 0 0 0\n0 2 0 0\n0 0 2 0\n0 0 0 1", "scales, shears or mirrors the scan by up to 100%"),
+    ("-1 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0 1", "scales, shears or mirrors"),
+])
+def test_a_non_rigid_alignment_matrix_is_one_line(matrix, message, tmp_path, capsys):
+    """An alignment only moves and turns scans: a matrix that projects (a transposed one),
+    scales or mirrors is refused, naming the scan, before any scan is read."""
+    (tmp_path / "scans.aln").write_text(f"1\nupper.ply\n#\n{matrix}\n0\n")
+    assert main(["reconstruct", str(tmp_path / "scans.aln"), "-o", str(tmp_path / "out.ply")]) == 1
+    line = one_error_line(capsys)
+    assert "scan upper.ply" in line and message in line
+
+
+def test_a_zero_quaternion_is_one_line(tmp_path, capsys):
+    (tmp_path / "scans.conf").write_text("bmesh upper.ply 0 0 0 0 0 0 0\n")
+    assert main(["reconstruct", str(tmp_path / "scans.conf"), "-o", str(tmp_path / "out.ply")]) == 1
+    assert "quaternion (qx qy qz qw) is zero" in one_error_line(capsys)

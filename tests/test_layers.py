@@ -199,3 +199,31 @@ def test_two_scans_offset_and_turned_give_one_sheet(plugin):
     gx, gy = 0.3 * np.cos(3 * x) * np.cos(2 * y), -0.2 * np.sin(3 * x) * np.sin(2 * y)
     truth = 4 * np.mean(np.sqrt(1 + gx ** 2 + gy ** 2))
     assert abs(area / truth - 1) < 0.05
+
+
+@pytest.mark.parametrize("matrix", [
+    [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0.3, 0, 0, 1]],  # projective (a transposed translation)
+    [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 0, 0], [0, 0, 0, 1]],  # flattens the layer onto z = 0
+])
+def test_a_layer_matrix_that_is_not_affine_or_invertible_is_refused(plugin, matrix):
+    """Merged or alone, a layer whose matrix projects or flattens it is named in the refusal,
+    with the filters that fix the matrix."""
+    points, normals = open_scan()
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=points, v_normals_matrix=normals), "good")
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=points, v_normals_matrix=normals), "tilted")
+    ms.set_matrix(transformmatrix=np.array(matrix, dtype=float), freeze=False)
+    for merge in (False, True):
+        with pytest.raises(pymeshlab.PyMeshLabException, match="matrix of layer 'tilted' is not affine or cannot be inverted"):
+            implicit_boundaries.apply(ms, merge_visible_layers=merge)
+    assert ms.mesh_number() == 2
+
+
+def test_merging_with_no_visible_scan_is_refused(plugin):
+    points, normals = open_scan()
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=points, v_normals_matrix=normals), "hidden")
+    ms.set_current_mesh_visibility(False)
+    with pytest.raises(pymeshlab.PyMeshLabException, match="No visible layer has vertices: show the scans to merge"):
+        implicit_boundaries.apply(ms, merge_visible_layers=True)
+    assert implicit_boundaries.apply(ms)["boundary_loops"] == 1  # the current layer, hidden or not

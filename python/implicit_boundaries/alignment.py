@@ -20,7 +20,24 @@ def read_alignment(path) -> list:
         raise ValueError(f"{path}: not an alignment file (MeshLab .aln or Stanford .conf)")
     if not scans:
         raise ValueError(f"{path}: lists no scans")
+    for name, matrix in scans:
+        _check_rigid(matrix, f"{path}: scan {name}")
     return [(path.parent / name, matrix) for name, matrix in scans]
+
+
+def _check_rigid(matrix, where):
+    """Raises ValueError unless matrix is a rigid motion: an alignment moves and turns a scan,
+    never scales, shears or projects it (a matrix written transposed has its translation in the
+    last row)."""
+    if not np.all(np.isfinite(matrix)):
+        raise ValueError(f"{where}: the matrix has a NaN or infinite entry")
+    if not np.allclose(matrix[3], [0, 0, 0, 1], atol=1e-6):
+        raise ValueError(f"{where}: the matrix's last row is {' '.join(f'{x:g}' for x in matrix[3])}, not 0 0 0 1: "
+                         "not a rigid motion (was it written transposed?)")
+    stretch = np.linalg.svd(matrix[:3, :3], compute_uv=False)
+    if np.abs(stretch - 1).max() > 1e-3 or np.linalg.det(matrix[:3, :3]) < 0:
+        raise ValueError(f"{where}: the matrix is not a rigid motion (it scales, shears or mirrors the scan by "
+                         f"up to {100 * np.abs(stretch - 1).max():.3g}%); an alignment only moves and turns scans")
 
 
 def _conf(lines, path):
@@ -38,6 +55,8 @@ def _conf(lines, path):
         if len(words) != 9:
             raise ValueError(f"{path}:{number}: expected 'bmesh FILE tx ty tz qx qy qz qw'")
         norm = np.sqrt(qx * qx + qy * qy + qz * qz + qw * qw)
+        if not norm > 0:
+            raise ValueError(f"{path}:{number}: the rotation quaternion (qx qy qz qw) is zero")
         qx, qy, qz, qw = qx / norm, qy / norm, qz / norm, qw / norm
         rotation = np.array([
             [1 - 2 * (qy * qy + qz * qz), 2 * (qx * qy - qz * qw), 2 * (qx * qz + qy * qw)],
