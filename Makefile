@@ -47,10 +47,12 @@ test-sanitize:
 fuzz: plugin
 	IB_FUZZ_PROFILE=fuzz IB_FUZZ_EXAMPLES=$(FUZZ_EXAMPLES) $(PYTHON) -m pytest -q tests/test_fuzz.py
 
-# Builds MeshLab 2025.07d (cached outside the repo) and checks that it loads our plugin.
+# Builds MeshLab 2025.07d (cached outside the repo), checks that it loads our plugin and runs it
+# from the Filters menu: on one scan, then on two aligned scans of an .aln project merged.
 gui: plugin
 	.ci/install-deps gui
 	tests/gui/apply_filter_in_meshlab.sh "$$(.ci/meshlab-gui)" python/implicit_boundaries/lib/libfilter_implicit_boundaries.so
+	tests/gui/merge_layers_in_meshlab.sh "$$(.ci/meshlab-gui)" python/implicit_boundaries/lib/libfilter_implicit_boundaries.so
 	@echo "Start MeshLab with the plugin: $$(.ci/meshlab-gui)/meshlab"
 	@echo "then Filters > Remeshing, Simplification and Reconstruction > Implicit reconstruction with boundaries"
 
