@@ -117,6 +117,8 @@ public:
     /// too. Thicker slabs (half a disk radius) closed the narrow holes of pymeshlab's bunny and
     /// split bun_zipper's holes into more loops, with no fewer gaps on the noisier gargoyle.
     static constexpr double kDiskSlack = 0.25;
+    /// A filled hole has at most this many faces per squared edge of its loops (see SmallHoles).
+    static constexpr double kPatchFacesPerSquaredEdge = 0.5;
     /// Automatic resolution: lattice cell = this × the median sample spacing. Tangent disks of
     /// one spacing cover a uniformly sampled surface at any cell size, so the cell is chosen for
     /// the boundaries: measured on the Stanford bunny scan (bun_zipper, 34,834 samples), 0.6
@@ -496,26 +498,36 @@ public:
     }
 
     /// Per hole region: 1 if it is an undersampling gap to fill, i.e. closed (the implicit
-    /// surface closes it within the search) and every loop along it has fewer than
-    /// `min_edges` edges. Also reports the edge counts of all loops before filling.
+    /// surface closes it within the search), every loop along it has fewer than `min_edges`
+    /// edges, and its hole faces span the loops as a patch, not a balloon: at most
+    /// kPatchFacesPerSquaredEdge × (its loops' edges)² faces. A flat patch inside a loop of L
+    /// edges has about L² / 2π of them; where the implicit surface closes a small gap by a
+    /// detour far from every sample (a torn tip whose fit bulges away), it has many more.
+    /// Also reports the edge counts of all loops before filling.
     static std::vector<int> SmallHoles(const CoreMesh& all, const std::vector<char>& inSurface,
                                        const GatedMarchingCubes::Result& mc, int min_edges, std::vector<int>& loopEdges)
     {
         std::vector<int> fill(mc.region_closed.begin(), mc.region_closed.end());
-        std::vector<char> touched(fill.size(), 0);
+        std::vector<double> edges(fill.size(), 0), faces(fill.size(), 0);
+        for (int region : mc.face_region)
+            ++faces[size_t(region)];
         for (const BoundaryLoop& loop : BoundaryLoops::Compute(all, inSurface)) {
             loopEdges.push_back(loop.Edges());
+            std::vector<size_t> regions;
             for (int face : loop.across) {
                 if (face < 0)
                     continue;  // a boundary of the whole closed surface (the lattice border)
-                const size_t region = size_t(mc.face_region[size_t(face) - mc.surface_faces]);
-                touched[region] = 1;
+                regions.push_back(size_t(mc.face_region[size_t(face) - mc.surface_faces]));
                 if (loop.Edges() >= min_edges)
-                    fill[region] = 0;
+                    fill[regions.back()] = 0;
             }
+            std::sort(regions.begin(), regions.end());
+            regions.erase(std::unique(regions.begin(), regions.end()), regions.end());
+            for (size_t region : regions)
+                edges[region] += loop.Edges();
         }
         for (size_t i = 0; i < fill.size(); ++i)
-            fill[i] = fill[i] && touched[i];
+            fill[i] = fill[i] && edges[i] > 0 && faces[i] <= kPatchFacesPerSquaredEdge * edges[i] * edges[i];
         return fill;
     }
 

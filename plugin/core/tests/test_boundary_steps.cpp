@@ -109,6 +109,69 @@ TEST(BoundarySteps, FlippedNormalsAreCutAlongTheFlip)
     EXPECT_EQ(OrientationSeam::Find(plateSamples, sides, SampleSpacing::Local(plateSamples)).rows(), 0);
 }
 
+/// The plane z = 0 (signed distance z) and, when `balloon`, a tube of radius 0.04 rising from it
+/// at (0.5, 0.5) into a ball of radius 0.15 at height 0.35: an implicit surface that closes a
+/// gap in a flat scan by a detour far from every sample.
+class PlaneWithBalloon : public ImplicitFunction
+{
+public:
+    explicit PlaneWithBalloon(bool balloon) : balloon_(balloon) {}
+    void Eval(const Points& Q, Eigen::Ref<Eigen::VectorXd> values) const override
+    {
+        for (Eigen::Index i = 0; i < Q.rows(); ++i) {
+            const Eigen::Vector3d q = Q.row(i).transpose();
+            const double radial = std::hypot(q[0] - 0.5, q[1] - 0.5);
+            const double tube = std::max(radial - 0.04, std::abs(q[2] - 0.1) - 0.2);
+            const double ball = (q - Eigen::Vector3d(0.5, 0.5, 0.35)).norm() - 0.15;
+            values[i] = balloon_ ? std::min(q[2], std::min(tube, ball)) : q[2];
+        }
+    }
+
+private:
+    bool balloon_;
+};
+
+TEST(BoundarySteps, AGapIsFilledByAPatchNotByABalloon)
+{
+    // A flat scan with a round gap of radius 0.1 (5 spacings), small by the edge count given.
+    Points all, allNormals;
+    FlatScan(0.02, all, allNormals);
+    std::vector<Eigen::Index> kept;
+    for (Eigen::Index i = 0; i < all.rows(); ++i)
+        if (std::hypot(all(i, 0) - 0.5, all(i, 1) - 0.5) > 0.1)
+            kept.push_back(i);
+    // And a small patch high above in a corner, where f has no zero: it only makes the lattice
+    // tall enough to hold the ball.
+    Points P(Eigen::Index(kept.size()) + 100, 3), N(P.rows(), 3);
+    P.topRows(Eigen::Index(kept.size())) = all(kept, Eigen::all);
+    N.topRows(Eigen::Index(kept.size())) = allNormals(kept, Eigen::all);
+    for (int i = 0; i < 100; ++i) {
+        P.row(Eigen::Index(kept.size()) + i) << 0.05 + 0.02 * (i % 10), 0.05 + 0.02 * (i / 10), 0.6;
+        N.row(Eigen::Index(kept.size()) + i) << 0, 0, 1;
+    }
+    Reconstruction::Param p;
+    p.implicit = Reconstruction::Implicit::Given;
+    p.resolution = 84;
+    p.min_boundary_edges = 80;
+    for (const bool balloon : {false, true}) {
+        const PlaneWithBalloon f(balloon);
+        p.given = &f;
+        CoreMesh m;
+        const auto r = Reconstruction::Compute(P, N, p, m);
+        double highest = 0;
+        for (const auto& v : m.vert)
+            highest = std::max(highest, v.cP()[2]);
+        // Flat: the gap is closed by the plane across it. Ballooned: the implicit surface
+        // across the gap is the tube and the ball (up to 0.5 high); the gap stays a hole.
+        EXPECT_EQ(r.loops.size(), balloon ? 2u : 1u) << (balloon ? "ballooned" : "flat");
+        EXPECT_EQ(r.holes_filled, balloon ? 0 : 1);
+        EXPECT_LT(highest, 2 * r.cell_size) << (balloon ? "ballooned" : "flat");
+        const auto t = test::Check(m);
+        EXPECT_EQ(t.non_manifold_edges, 0);
+        EXPECT_TRUE(t.oriented);
+    }
+}
+
 TEST(BoundarySteps, PinchKeepsTheLargerFan)
 {
     // Three triangles around the origin on one side, one on the other: they meet only at (0,0,0).
