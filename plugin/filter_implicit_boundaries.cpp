@@ -6,6 +6,8 @@
 #include <vcg/complex/algorithms/update/selection.h>
 #include <vcg/complex/append.h>
 
+#include <optional>
+
 namespace {
 
 // The first two match ib::Reconstruction::NormalSource; the third is Estimate with the viewpoint.
@@ -99,6 +101,75 @@ ib::Points stackedMatrix(const std::vector<const MeshModel*>& layers, bool norma
 		row += m->cm.vn;
 	}
 	return out;
+}
+
+/// Which layers oriented estimated normals by what (facingMatrix).
+struct FacingSources
+{
+	int cameras = 0, triangles = 0, viewpoint = 0;
+};
+
+/// Per vertex of `layers` (rows as stackedMatrix), the direction its estimated normal must
+/// face, in the common frame: towards the layer's camera when it has one (a scan imported with
+/// its scanner's position), else along the layer's triangles around it (a range grid's
+/// triangles face its scanner), else towards `viewpoint` when given; zero (unknown: oriented
+/// by the neighbours) for a point layer with neither.
+ib::Points facingMatrix(const std::vector<const MeshModel*>& layers, const std::optional<Eigen::Vector3d>& viewpoint,
+						FacingSources& used)
+{
+	Eigen::Index rows = 0;
+	for (const MeshModel* m : layers)
+		rows += m->cm.vn;
+	ib::Points out = ib::Points::Zero(rows, 3);
+	Eigen::Index row = 0;
+	for (const MeshModel* m : layers) {
+		const ib::Points positions = vertexMatrix(m->cm, false);
+		auto towards = [&](const Eigen::Vector3d& v) { out.middleRows(row, m->cm.vn) = (-positions).rowwise() + v.transpose(); };
+		if (m->cm.shot.IsValid()) {
+			const Point3m v = m->cm.Tr * m->cm.shot.GetViewPoint();  // the shot lies in the layer's own frame
+			towards(Eigen::Vector3d(v[0], v[1], v[2]));
+			++used.cameras;
+		}
+		else if (m->cm.fn > 0) {
+			// Area-weighted normals of the triangles around each vertex, through the matrix as
+			// normals go (vertexMatrix).
+			CMeshO grid;
+			vcg::tri::Append<CMeshO, CMeshO>::MeshCopyConst(grid, m->cm);
+			vcg::tri::Allocator<CMeshO>::CompactEveryVector(grid);
+			for (auto& v : grid.vert)
+				v.N() = Point3m(0, 0, 0);
+			for (auto& f : grid.face)
+				for (int k = 0; k < 3; ++k)
+					f.V(k)->N() += vcg::TriangleNormal(f);
+			grid.Tr = m->cm.Tr;
+			out.middleRows(row, m->cm.vn) = vertexMatrix(grid, true);
+			++used.triangles;
+		}
+		else if (viewpoint) {
+			towards(*viewpoint);
+			++used.viewpoint;
+		}
+		row += m->cm.vn;
+	}
+	return out;
+}
+
+/// How estimated normals were oriented, for the log: "facing each layer's camera", ...
+QString orientation(const FacingSources& used, const std::optional<Eigen::Vector3d>& viewpoint, int layers)
+{
+	QStringList by;
+	if (used.cameras)
+		by << QString("towards the camera of %1 layer(s)").arg(used.cameras);
+	if (used.triangles)
+		by << QString("along the triangles of %1 layer(s)").arg(used.triangles);
+	if (used.viewpoint)
+		by << QString("towards the viewpoint (%1, %2, %3)").arg((*viewpoint)[0]).arg((*viewpoint)[1]).arg((*viewpoint)[2]);
+	const int rest = layers - used.cameras - used.triangles - used.viewpoint;
+	if (by.isEmpty())
+		return "by propagation";
+	if (rest > 0)
+		by << QString("as their neighbours for the %1 other layer(s)").arg(rest);
+	return by.join(", ");
 }
 
 Eigen::VectorXd toVector(const std::vector<double>& v)
@@ -349,16 +420,17 @@ RichParameterList FilterImplicitBoundariesPlugin::reconstructionParameters(const
 		"normals", int(d.normals), kNormalSources, "Normals",
 		"Where the oriented normals that define inside and outside come from. 'Use layer normals' "
 		"takes the layer's own (a scan's normals are usually best), estimates the zero or NaN ones "
-		"among them facing the way their neighbours face, and all of them when the layer has none; 'Estimate' always fits them (PCA over neighbours, "
-		"oriented by propagation); 'Estimate, facing the viewpoint' orients them towards the "
-		"viewpoint below, the scanner's position for a single range scan (propagation can flip "
-		"whole regions of a thin or sparse scan: the surface then comes out inside-out there, "
-		"with a seam of boundary where the flipped region meets the rest). The log says when "
-		"normals were estimated."));
+		"among them facing the way their neighbours face, and all of them when the layer has none; 'Estimate' always fits them (PCA over neighbours). "
+		"Estimated normals of each layer face its camera when it has one (a scan imported with its "
+		"scanner's position), else follow its triangles when it has faces (a range grid faces its "
+		"scanner), else, with 'Estimate, facing the viewpoint', face the viewpoint below; the rest "
+		"are oriented by propagation, which can flip whole regions of a thin or sparse scan (the "
+		"surface then comes out inside-out there, with a seam of boundary where the flipped region "
+		"meets the rest). The log says when and how normals were estimated."));
 	par.addParam(RichPosition(
 		"viewpoint", Point3m(0, 0, 0), "Viewpoint",
 		"With 'Estimate, facing the viewpoint': the position the scan was taken from; every "
-		"estimated normal is turned to face it."));
+		"estimated normal of a layer without camera or faces is turned to face it."));
 	par.addParam(RichEnum(
 		"extraction", int(d.extraction), kExtractions, "Extraction",
 		"'SODS-driven' evaluates the implicit function only at the corners of occupied cells "
@@ -407,9 +479,10 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 	const int normals = par.getEnum("normals");
 	p.normals = normals == kNormalsFacingViewpoint ? ib::Reconstruction::NormalSource::Estimate
 												   : ib::Reconstruction::NormalSource(normals);
+	std::optional<Eigen::Vector3d> viewpoint;
 	if (normals == kNormalsFacingViewpoint) {
 		const Point3m v = par.getPoint3m("viewpoint");
-		p.viewpoint = Eigen::Vector3d(v[0], v[1], v[2]);
+		viewpoint = Eigen::Vector3d(v[0], v[1], v[2]);
 	}
 	p.normal_neighbours = par.getInt("normal_neighbours");
 	p.min_boundary_edges = par.getInt("min_boundary_edges");
@@ -441,8 +514,13 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 	if (layers.size() > 1)
 		for (const MeshModel* m : layers)
 			p.scan_sizes.push_back(m->cm.vn);
+	const ib::Points layerNormals = stackedMatrix(layers, true);
+	FacingSources facing;
+	if (p.normals == ib::Reconstruction::NormalSource::Estimate || !layerNormals.array().isFinite().all() ||
+		(layerNormals.array() == 0).all())
+		p.facing = facingMatrix(layers, viewpoint, facing);
 	try {
-		r = ib::Reconstruction::Compute(positions, stackedMatrix(layers, true), p, surface,
+		r = ib::Reconstruction::Compute(positions, layerNormals, p, surface,
 										holeLayer ? &holes : nullptr, cb);
 	}
 	catch (const ib::InputError& e) {
@@ -518,10 +596,7 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 	if (r.normals_estimated)
 		log("Input had no usable normals (or estimation was requested): estimated them from %d "
 			"neighbours and oriented them %s%s; %zu turned to agree with their neighbours.",
-			p.normal_neighbours,
-			p.viewpoint ? qUtf8Printable(QString("towards the viewpoint (%1, %2, %3)")
-											 .arg((*p.viewpoint)[0]).arg((*p.viewpoint)[1]).arg((*p.viewpoint)[2]))
-						: "by propagation",
+			p.normal_neighbours, qUtf8Printable(orientation(facing, viewpoint, int(layers.size()))),
 			r.normals_flipped ? " (flipped to point away from the centroid)" : "", r.normals_turned);
 	log("Implicit function: %s%s, built in %.2f s.", qUtf8Printable(kImplicits[int(p.implicit)]),
 		r.rbf_cells > 0 ? qUtf8Printable(QString(" (%1 local RBF fits)").arg(r.rbf_cells)) : "", r.seconds_implicit);

@@ -227,3 +227,73 @@ def test_merging_with_no_visible_scan_is_refused(plugin):
     with pytest.raises(pymeshlab.PyMeshLabException, match="No visible layer has vertices: show the scans to merge"):
         implicit_boundaries.apply(ms, merge_visible_layers=True)
     assert implicit_boundaries.apply(ms)["boundary_loops"] == 1  # the current layer, hidden or not
+
+
+def save_scan_with_camera(path, points, camera):
+    """An ASCII PLY of `points` (no normals) with a camera element whose viewpoint is `camera`
+    (MeshLab reads it as the layer's shot, in the scan's own frame)."""
+    fields = ["view_px", "view_py", "view_pz", "x_axisx", "x_axisy", "x_axisz", "y_axisx", "y_axisy", "y_axisz",
+              "z_axisx", "z_axisy", "z_axisz", "focal", "scalex", "scaley", "centerx", "centery"]
+    header = ["ply", "format ascii 1.0", "element camera 1"] + [f"property float {f}" for f in fields]
+    header += [f"property int {f}" for f in ("viewportx", "viewporty")]
+    header += [f"property float {f}" for f in ("k1", "k2", "k3", "k4")]
+    header += [f"element vertex {len(points)}", "property float x", "property float y", "property float z", "end_header"]
+    camera_row = [*camera, 1, 0, 0, 0, 1, 0, 0, 0, 1, 1, 0.01, 0.01, 320, 240, 640, 480, 0, 0, 0, 0]
+    rows = [" ".join(f"{x:.9g}" for x in camera_row)] + [" ".join(f"{x:.9g}" for x in p) for p in points]
+    path.write_text("\n".join(header + rows) + "\n")
+
+
+def inward_fraction(mesh):
+    v, f = mesh.vertex_matrix(), mesh.face_matrix()
+    normal = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
+    return float((np.sum(normal * v[f].mean(axis=1), axis=1) < 0).mean())
+
+
+def test_estimated_normals_face_each_scans_camera(plugin, tmp_path):
+    """A room scanned from inside: the unit sphere as two overlapping scans without normals,
+    each with its scanner's position as the layer's camera (a PLY camera element), the lower
+    scan stored in its own frame with the matrix that places it. Merged with estimated normals,
+    every normal faces its scanner: the surface faces inward (propagation alone turns a closed
+    surface outward, away from its centre: inside out for a room)."""
+    u = fibonacci_sphere(6000)
+    upper, lower = u[u[:, 2] > -0.2], u[u[:, 2] < 0.2]
+    matrix = np.eye(4)
+    matrix[:3, :3] = rotation_about_z(90)
+    matrix[:3, 3] = [0.2, 0, 0]
+    lower_local = (lower - matrix[:3, 3]) @ matrix[:3, :3]
+    camera_local = (np.array([0, 0, -0.1]) - matrix[:3, 3]) @ matrix[:3, :3]
+    save_scan_with_camera(tmp_path / "upper.ply", upper, [0, 0, 0.1])
+    save_scan_with_camera(tmp_path / "lower.ply", lower_local, camera_local)
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(str(tmp_path / "upper.ply"))
+    ms.load_new_mesh(str(tmp_path / "lower.ply"))
+    ms.set_matrix(transformmatrix=matrix, freeze=False)
+    out = implicit_boundaries.apply(ms, merge_visible_layers=True, normals="Estimate")
+    assert out["normals_estimated"] and out["boundary_loops"] == 0
+    assert inward_fraction(ms.current_mesh()) > 0.99
+    # Without cameras (the same points in plain layers): outward.
+    plain = pymeshlab.MeshSet()
+    plain.add_mesh(pymeshlab.Mesh(vertex_matrix=upper))
+    plain.add_mesh(pymeshlab.Mesh(vertex_matrix=lower))
+    implicit_boundaries.apply(plain, merge_visible_layers=True, normals="Estimate")
+    assert inward_fraction(plain.current_mesh()) < 0.01
+
+
+def test_estimated_normals_follow_the_range_grids_triangles(plugin):
+    """A scan with faces (MeshLab triangulates a range grid on import), its triangles facing
+    the inside of the sphere: estimated normals follow them (inward); a point layer of the same
+    vertices comes out outward."""
+    u = fibonacci_sphere(4000)
+    hull = pymeshlab.MeshSet()
+    hull.add_mesh(pymeshlab.Mesh(vertex_matrix=u))
+    hull.generate_convex_hull()
+    faces = hull.current_mesh().face_matrix()[:, ::-1]  # turned inward
+    vertices = hull.current_mesh().vertex_matrix()
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=vertices, face_matrix=faces), "range grid")
+    implicit_boundaries.apply(ms, normals="Estimate")
+    assert inward_fraction(ms.current_mesh()) > 0.99
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=vertices), "points")
+    implicit_boundaries.apply(ms, normals="Estimate")
+    assert inward_fraction(ms.current_mesh()) < 0.01

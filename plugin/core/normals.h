@@ -42,6 +42,10 @@ public:
         int neighbours = 15;                      ///< k of the PCA fit and of the propagation
         int smoothing_iterations = 0;             ///< neighbour averaging passes after the fit
         std::optional<Eigen::Vector3d> viewpoint; ///< scanner position: normals face it
+        /// n×3, or empty: per sample, a direction its normal must face (towards the scanner of
+        /// its scan, or its range grid's triangle normal); zero rows: unknown, oriented by
+        /// their neighbours. Used without a viewpoint.
+        Points facing;
         int threads = 0;                          ///< for the neighbour vote; 0 = all cores
     };
 
@@ -81,6 +85,16 @@ public:
             for (Eigen::Index i = 0; i < P.rows(); ++i)
                 if (N.row(i).dot(p.viewpoint->transpose() - P.row(i)) < 0)
                     N.row(i) = -N.row(i);
+        } else if (p.facing.rows() == P.rows() && (p.facing.array() != 0).any()) {
+            std::vector<Eigen::Index> unknown;
+            for (Eigen::Index i = 0; i < P.rows(); ++i) {
+                const double agree = N.row(i).dot(p.facing.row(i));
+                if (agree < 0)
+                    N.row(i) = -N.row(i);
+                else if (!(agree > 0))  // no direction given (or one in the tangent plane)
+                    unknown.push_back(i);
+            }
+            FillMissing(samples, N, unknown, p.neighbours);
         } else {
             r.flipped = Propagate(samples, p.neighbours, N);
         }

@@ -153,6 +153,10 @@ public:
         NormalSource normals = NormalSource::LayerOrEstimate;
         int normal_neighbours = 15;  ///< k for normal estimation (10 flips normals on noisy scans; see README)
         std::optional<Eigen::Vector3d> viewpoint;  ///< orient estimated normals towards it
+        /// n×3 (rows as the input) or empty: per sample, a direction its estimated normal must
+        /// face, e.g. towards the scanner of its scan (the layer's camera) or along its range
+        /// grid's triangles; zero rows: none. Used when normals are estimated, without viewpoint.
+        Points facing;
         Implicit implicit = Implicit::PuRbf;
         PuRbf::Param rbf;            ///< the PU-RBF's cells and fits (threads: taken from `threads`)
         int hoppe_neighbours = 8;    ///< tangent planes blended by the signed distance
@@ -269,7 +273,7 @@ private:
                              "out; at least " + std::to_string(kMinPoints) + " are needed to fit tangent planes.");
 
         const SampleIndex samples(P);  // the k-d tree every stage shares, from normals to the trim
-        const Points normals = OrientedNormals(samples, N, p, r, cb);
+        const Points normals = OrientedNormals(samples, N, p.facing.rows() ? Points(p.facing(kept, Eigen::all)) : Points(), p, r, cb);
         r.seconds_normals = seconds(t);
 
         t = Clock::now();
@@ -422,9 +426,10 @@ public:
         }
     }
 
-    /// Unit normals: the layer's, or estimated ones (and says so in r).
-    static Points OrientedNormals(const SampleIndex& samples, const Points& N, const Param& p, Result& r,
-                                  vcg::CallBackPos* cb)
+    /// Unit normals: the layer's, or estimated ones (and says so in r), turned to the rows of
+    /// `facing` (per sample, see Param::facing; empty: none).
+    static Points OrientedNormals(const SampleIndex& samples, const Points& N, const Points& facing, const Param& p,
+                                  Result& r, vcg::CallBackPos* cb)
     {
         if (p.normals == NormalSource::LayerOrEstimate && HasNormals(N)) {
             Points normals = N;
@@ -444,6 +449,7 @@ public:
         PointNormals::Param np;
         np.neighbours = p.normal_neighbours;
         np.viewpoint = p.viewpoint;
+        np.facing = facing;
         np.threads = p.threads;
         r.normals_estimated = true;
         PointNormals::Report report;
@@ -646,6 +652,9 @@ private:
             Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(centred.transpose() * centred).eigenvalues();  // ascending
         if (!(spread[1] > 1e-12 * spread[2]))  // second extent under a millionth of the first
             throw InputError("All vertices lie on one line: a surface needs samples spread in two directions.");
+        if (p.facing.rows() != 0 && p.facing.rows() != P.rows())
+            throw InputError("The facing directions have " + std::to_string(p.facing.rows()) + " rows for " +
+                             std::to_string(P.rows()) + " samples.");
         if (p.resolution != 0 && (p.resolution < kMinResolution || p.resolution > kMaxResolution))
             throw InputError("Resolution " + std::to_string(p.resolution) + " is out of range: use 0 (automatic, " +
                              "from the sample spacing) or a value between " + std::to_string(kMinResolution) +

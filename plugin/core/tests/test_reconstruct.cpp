@@ -129,6 +129,37 @@ TEST(Reconstruction, FillsMissingNormalsAndKeepsTheGivenOnes)
     EXPECT_EQ(inward, m.face.size());
 }
 
+TEST(Reconstruction, EstimatedNormalsFaceTheGivenDirections)
+{
+    // Normals estimated on a sphere, the upper half's samples told to face the centre (as if
+    // scanned from inside: a scanner's position or its range grid's triangles), the lower
+    // half told nothing: every normal faces inward, the lower half's by following its
+    // neighbours; propagation alone turns them all outward. A facing matrix of the wrong size
+    // is refused.
+    Points P, N;
+    test::SpherePoints(3000, 1.0, P, N);
+    Reconstruction::Param p;
+    p.normals = Reconstruction::NormalSource::Estimate;
+    for (const bool facing : {false, true}) {
+        p.facing = facing ? Points(-P) : Points();
+        if (facing)
+            for (Eigen::Index i = 0; i < P.rows(); ++i)
+                if (P(i, 2) < 0)
+                    p.facing.row(i).setZero();
+        CoreMesh m;
+        const auto r = Reconstruction::Compute(P, Points(), p, m);
+        EXPECT_TRUE(r.normals_estimated);
+        EXPECT_TRUE(r.loops.empty());
+        size_t inward = 0;
+        for (const CoreFace& f : m.face)
+            inward += vcg::TriangleNormal(f).dot(vcg::Barycenter(f)) < 0;
+        EXPECT_EQ(inward, facing ? m.face.size() : 0u) << (facing ? "facing the centre" : "propagated");
+    }
+    p.facing = Points::Zero(10, 3);
+    CoreMesh m;
+    EXPECT_THROW(Reconstruction::Compute(P, Points(), p, m), InputError);
+}
+
 TEST(Reconstruction, SameOutputOnOneAndTwoThreads)
 {
     Points P, N;
