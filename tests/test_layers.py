@@ -297,3 +297,31 @@ def test_estimated_normals_follow_the_range_grids_triangles(plugin):
     ms.add_mesh(pymeshlab.Mesh(vertex_matrix=vertices), "points")
     implicit_boundaries.apply(ms, normals="Estimate")
     assert inward_fraction(ms.current_mesh()) < 0.01
+
+
+def test_a_gap_no_scan_reached_is_filled_and_a_real_hole_kept(plugin):
+    """Two overlapping scans of the wavy sheet, neither reaching a strip 4 spacings wide and 20
+    long in their overlap (occlusion: a gap in the coverage, its loop far over the edge count of
+    an undersampling gap), and a round hole of radius 8 spacings in the second scan's part.
+    Merged: the strip, within 2 spacings of the samples everywhere, is filled; the hole, 8
+    spacings deep, stays: the sheet's border and the hole. The same samples as one scan keep
+    the strip open (a single scan's gaps are judged by their loops' size)."""
+    spacing = 0.02
+    rng = np.random.default_rng(2)
+    scans = [strip_scan((-1, 0.3), spacing, rng), strip_scan((-0.3, 1), spacing, rng)]
+    kept = []
+    for points, normals in scans:
+        strip = (np.abs(points[:, 0]) < 2 * spacing) & (np.abs(points[:, 1]) < 10 * spacing)
+        hole = np.hypot(points[:, 0] - 0.6, points[:, 1] - 0.4) < 8 * spacing
+        kept.append((points[~strip & ~hole], normals[~strip & ~hole]))
+    merged = pymeshlab.MeshSet()
+    for points, normals in kept:
+        merged.add_mesh(pymeshlab.Mesh(vertex_matrix=points, v_normals_matrix=normals))
+    out = implicit_boundaries.apply(merged, merge_visible_layers=True)
+    loops = implicit_boundaries.loops_from_result(out)
+    assert len(loops) == 2
+    centre = merged.current_mesh().vertex_matrix()[loops[1]].mean(axis=0)
+    assert np.hypot(centre[0] - 0.6, centre[1] - 0.4) < spacing  # the round hole
+    one = pymeshlab.MeshSet()
+    one.add_mesh(pymeshlab.Mesh(vertex_matrix=np.vstack([p for p, _ in kept]), v_normals_matrix=np.vstack([n for _, n in kept])))
+    assert implicit_boundaries.apply(one)["boundary_loops"] == 3
