@@ -11,7 +11,9 @@ larger and randomised examples (``IB_FUZZ_EXAMPLES`` sets how many).
 """
 import multiprocessing
 import os
+import re
 import traceback
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -250,13 +252,32 @@ def check_loops(vertices, faces, result, selected):
     assert np.array_equal(np.unique(selected), np.unique(flat)), "selected vertices are not the loop vertices"
 
 
+# The refusals README's table documents, one pattern each (test_documented_refusals_are_in_the_readme checks
+# that the table shows each). Anything else is an internal failure, among them "... failed (...).
+# Please report it" and "ran out of memory" (the memory guard should have refused first).
+DOCUMENTED_REFUSALS = [
+    r"The layer has no vertices", r"The layer has only \d+ vertices", r"Only \d+ distinct vertex positions",
+    r"Only \d+ samples are left once \d+ outliers", r"\d+ of \d+ vertices have NaN or infinite coordinates",
+    r"All vertices are at the same position", r"All vertices lie on one line", r"Resolution \d+ is out of range",
+    r"SODS dilation must be between 0 and 8", r"The sample radius must be between 0.25 and 8",
+    r"Normal neighbours must be between 3 and 256", r"The minimum number of boundary edges cannot be negative",
+    r"Boundary smoothing must be between 0 and 100", r"The boundary trim must be between 0 \(off\) and 8",
+    r"The PU-RBF's minimum samples per cell must be between", r"The PU-RBF's maximum samples per cell must be between",
+    r"The PU-RBF's overlap must be between", r"The PU-RBF's off-surface distance must be above 0",
+    r"The memory limit cannot be negative", r"Resolution \d+ would need about \S+ GB of memory",
+    r"No surface was extracted at resolution \d+", r"The implicit mesh layer '[^']*' (has no faces|cannot be used)",
+]
+
+
 def check_answer(answer, params):
     status = answer["status"]
     assert status in ("ok", "refused"), f"{status}: {answer['message']}"
     expected = (status == "ok") * (1 + bool(params.get("hole_layer")))
     assert answer["new_layers"] == expected, f"{answer['new_layers']} new layers after a {status} run"
     if status == "refused":
-        assert answer["message"].strip(), "refused without a message"
+        message = answer["message"]
+        assert "failed (" not in message, f"internal failure: {message}"
+        assert any(re.search(pattern, message) for pattern in DOCUMENTED_REFUSALS), f"undocumented refusal: {message}"
         return
     vertices, faces, result = answer["vertices"], answer["faces"], answer["result"]
     assert answer["current"] == answer["surface_layer"], "the new surface is not the current layer"
@@ -304,6 +325,9 @@ def with_row(array, row, value):
 REFUSED = {
     "infinite coordinate": (lambda: (with_row(flat_scan()[0], 5, [np.inf, 0, 0]), None), {},
                             "1 of 600 vertices have NaN or infinite"),
+    "9 samples once 3 outliers are left out": (
+        lambda: (np.vstack([flat_scan(9)[0] * 0.01, [[5.0, 0, 0], [0, 7.0, 0], [0, 0, 9.0]]]), None), {},
+        "Only 9 samples are left once 3 outliers"),
     "resolution 7": (flat_scan, dict(resolution=7), "Resolution 7 is out of range"),
     "dilation 9": (flat_scan, dict(sods_dilation=9), "SODS dilation must be between 0 and 8"),
     "radius 8.5": (flat_scan, dict(sample_radius=8.5), "sample radius must be between 0.25 and 8"),
@@ -357,7 +381,8 @@ def test_odd_but_valid_inputs_give_a_surface(worker, name):
 # ---------------------------------------------------------------------------------------------
 # What the fuzzing found, kept as regressions: (recipe, parameters, what must come out).
 
-DEFAULT_PARAMS = {"resolution": 0, "implicit": "Hoppe signed distance", "sods_occupancy": "Tangent disks",
+# The parameters the fuzzer ran with when it found these (not the filter's defaults).
+FOUND_WITH = {"resolution": 0, "implicit": "Hoppe signed distance", "sods_occupancy": "Tangent disks",
                   "sods_dilation": 0, "sample_radius": 1.0, "min_boundary_edges": 12, "boundary_smoothing": 0,
                   "boundary_trim": 0.5, "extraction": "SODS-driven", "normals": "Use layer normals",
                   "hole_layer": False}
@@ -380,8 +405,17 @@ FOUND = {
 @pytest.mark.parametrize("name", FOUND)
 def test_fuzzing_findings(worker, name):
     recipe, params, message = FOUND[name]
-    answer = run_recipe(worker, recipe, {**DEFAULT_PARAMS, **params})
+    answer = run_recipe(worker, recipe, {**FOUND_WITH, **params})
     if message is None:
         assert answer["status"] == "ok", answer.get("message")
     else:
         assert answer["status"] == "refused" and message in answer["message"], answer.get("message")
+
+
+def test_documented_refusals_are_in_the_readme():
+    """Every refusal the fuzz tests accept is shown in README's table of refused inputs."""
+    readme = (Path(__file__).parent.parent / "README.md").read_text()
+    table = readme[readme.index("| input or parameter value | message (excerpt) | test |"):]
+    table = table[:table.index("\n\n")].replace("…", "X")
+    missing = [pattern for pattern in DOCUMENTED_REFUSALS if not re.search(pattern, table)]
+    assert not missing, f"README's refusal table lacks {missing}"
