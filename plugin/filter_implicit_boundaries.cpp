@@ -551,7 +551,7 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 			for (int v : loop.vertices)
 				out->cm.vert[v].SetS();
 		out->updateBoxAndNormals();
-		if (holeLayer) {
+		if (holeLayer && holes.fn > 0) {  // no empty layer when no hole is kept
 			MeshModel* holeModel = md.addNewMesh("", label + " holes", false);
 			added.push_back(holeModel->id());
 			vcg::tri::Append<CMeshO, ib::CoreMesh>::MeshCopyConst(holeModel->cm, holes);
@@ -612,6 +612,8 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 		"boundary vertices fitted to the samples' edge.",
 		out->cm.fn, out->cm.vn, int(r.loops.size()), qUtf8Printable(loopSummary(r.loops)),
 		r.holes_filled, p.min_boundary_edges, r.faces_trimmed, r.boundary_vertices_fitted);
+	if (holeLayer && holes.fn == 0)
+		log("No hole triangles to show (every hole was filled, or none closes): no holes layer added.");
 	if (r.seam_points > 0)
 		log("The normals flip between neighbouring samples at %zu places (a one-sided surface, or a region "
 			"oriented inside out): cut the surface there (%zu faces) into a boundary. If that region should "
@@ -631,6 +633,7 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 	res["boundary_loops_before_filling"] = QVariant::fromValue(toVector(
 		std::vector<double>(r.loops_before_filling.begin(), r.loops_before_filling.end())));
 	res["holes_filled"] = r.holes_filled;
+	res["hole_faces"] = holes.fn;
 	res["hole_cells"] = double(r.hole_cells);
 	res["faces_trimmed"] = double(r.faces_trimmed);
 	res["boundary_vertices_fitted"] = double(r.boundary_vertices_fitted);

@@ -113,7 +113,7 @@ def test_hole_layer_closes_the_surface(plugin):
     assert ms.mesh_number() == 3
     assert ms.current_mesh_id() == 1  # the surface stays current
     assert [ms.mesh(i).label() for i in range(3)] == ["points", "points with boundaries", "points holes"]
-    assert ms.mesh(2).face_number() > 0
+    assert ms.mesh(2).face_number() == result["hole_faces"] > 0
     # Surface + holes is the closed implicit surface: merged, the bunny is a closed sphere-like
     # 2-manifold (the implicit function closes every hole of this scan).
     assert result["boundary_loops"] > 0
@@ -123,10 +123,12 @@ def test_hole_layer_closes_the_surface(plugin):
 
 
 def test_closed_bunny_has_no_boundary(plugin):
+    """Closed: no loop, and with hole_layer no empty holes layer is added."""
     points, normals, _ = point_cloud(SAMPLES / "bunny.obj")
     ms = new_set(points, normals)
-    result = getattr(ms, FILTER)()
-    assert result["boundary_loops"] == 0
+    result = getattr(ms, FILTER)(hole_layer=True)
+    assert result["boundary_loops"] == 0 and result["hole_faces"] == 0
+    assert ms.mesh_number() == 2
     measures = ms.get_topological_measures()
     assert measures["boundary_edges"] == 0
     assert measures["non_two_manifold_edges"] == 0

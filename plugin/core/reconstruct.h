@@ -279,7 +279,8 @@ private:
                              "out; at least " + std::to_string(kMinPoints) + " are needed to fit tangent planes.");
 
         const SampleIndex samples(P);  // the k-d tree every stage shares, from normals to the trim
-        const Points normals = OrientedNormals(samples, N, p.facing.rows() ? Points(p.facing(kept, Eigen::all)) : Points(), p, r, cb);
+        const Points facing = p.facing.rows() ? Points(p.facing(kept, Eigen::all)) : Points();
+        const Points normals = OrientedNormals(samples, N, facing, p, r, cb);
         r.seconds_normals = seconds(t);
 
         t = Clock::now();
@@ -546,10 +547,10 @@ public:
         }
         std::vector<char> candidate(fill.size(), 0);
         for (size_t i = 0; i < fill.size(); ++i) {
-            const bool patch = edges[i] > 0 && faces[i] <= kPatchFacesPerSquaredEdge * edges[i] * edges[i];
-            fill[i] = fill[i] && patch;
-            candidate[i] = fill[i] && large[i];
-            fill[i] = fill[i] && !large[i];
+            const bool closedPatch =
+                fill[i] && edges[i] > 0 && faces[i] <= kPatchFacesPerSquaredEdge * edges[i] * edges[i];
+            candidate[i] = closedPatch && large[i];
+            fill[i] = closedPatch && !large[i];
         }
         if (coverage) {
             const std::vector<double> depth = RegionDepths(all, mc, candidate, *coverage, spacing, threads);
