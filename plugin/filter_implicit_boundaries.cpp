@@ -612,6 +612,9 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 		"boundary vertices fitted to the samples' edge.",
 		out->cm.fn, out->cm.vn, int(r.loops.size()), qUtf8Printable(loopSummary(r.loops)),
 		r.holes_filled, p.min_boundary_edges, r.faces_trimmed, r.boundary_vertices_fitted);
+	if (r.faces_not_manifold > 0 || r.vertices_split > 0)
+		log("Made the surface a 2-manifold: removed %zu faces from edges shared by more than two faces, split %zu "
+			"vertices where separate fans met.", r.faces_not_manifold, r.vertices_split);
 	if (holeLayer && holes.fn == 0)
 		log("No hole triangles to show (every hole was filled, or none closes): no holes layer added.");
 	if (r.seam_points > 0)
@@ -642,6 +645,8 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 	res["duplicates_removed"] = double(r.duplicates_removed);
 	res["outliers_removed"] = double(r.outliers.size());
 	res["faces_unsupported"] = double(r.faces_unsupported);
+	res["faces_not_manifold"] = double(r.faces_not_manifold);
+	res["vertices_split"] = double(r.vertices_split);
 	res["surface_faces"] = out->cm.fn;
 	res["surface_vertices"] = out->cm.vn;
 	res["resolution"] = r.resolution;

@@ -11,6 +11,7 @@
 #include "gated_mc.h"
 #include "implicit/hoppe.h"
 #include "implicit/pu_rbf.h"
+#include "manifold_check.h"
 #include "memory_budget.h"
 #include "normals.h"
 #include "orientation_seam.h"
@@ -202,6 +203,8 @@ public:
         size_t duplicates_removed = 0;    ///< samples at the same position as an earlier one
         std::vector<Eigen::Index> outliers;  ///< input rows left out as outliers (outliers.h), ascending
         size_t faces_unsupported = 0;     ///< faces of pieces supported by fewer than kMinPoints samples
+        size_t faces_not_manifold = 0;    ///< faces removed from edges shared by more than two faces (manifold_check.h)
+        size_t vertices_split = 0;        ///< vertices where separate fans met, split (manifold_check.h)
         size_t hole_cells = 0;
         bool hole_search_capped = false;
         int resolution = 0;
@@ -357,6 +360,12 @@ private:
             throw InputError("No surface was extracted at resolution " + std::to_string(r.resolution) +
                              ": the samples are too few or too scattered to outline a surface. Try a lower "
                              "resolution, a larger sample radius or SODS dilation, or more samples.");
+        const ManifoldCheck::Result check = ManifoldCheck::Repair(surface);
+        r.faces_not_manifold = check.faces_removed;
+        r.vertices_split = check.vertices_split;
+        if (!check.manifold || !check.oriented)
+            throw std::logic_error(std::string("the surface is not ") + (check.manifold ? "oriented" : "a 2-manifold") +
+                                   " after its repair");
         r.loops = BoundaryLoops::Compute(surface);
         ReleaseFreedMemory();  // before the host copies the surface
         r.seconds_boundaries = seconds(t);

@@ -1,12 +1,15 @@
 // Trim, pinch resolution, scraps and smoothing, on hand-made meshes and a flat scan.
 #include "boundary_trim.h"
 #include "fold_guard.h"
+#include "manifold_check.h"
 #include "geometry.h"
 #include "orientation_seam.h"
 #include "pinches.h"
 #include "reconstruct.h"
 
 #include <gtest/gtest.h>
+
+#include <array>
 
 using namespace ib;
 
@@ -232,4 +235,38 @@ TEST(BoundarySteps, FoldGuardUndoesAMoveThatFoldsAFace)
     MoveVertex(m, centre, Eigen::Vector3d(1e-3, 0.9999, 0));  // flattens a face to a sliver
     FoldGuard::Restore(m, moved, start);
     EXPECT_LT(PositionOf(m, centre)[1], 0.5);
+}
+
+TEST(BoundarySteps, ManifoldCheckRepairsFinsAndBowTies)
+{
+    // Vertices 0..6; a fin: faces 0-1-2, 1-0-3 and 0-1-4 share edge 0-1 (the third face is
+    // removed); a bow tie: 2-5-6 touches the rest at vertex 2 only (split into its own vertex).
+    auto build = [](CoreMesh& m, const std::vector<std::array<int, 3>>& faces) {
+        auto v = vcg::tri::Allocator<CoreMesh>::AddVertices(m, 7);
+        const double xyz[7][3] = {{0, 0, 0}, {1, 0, 0}, {0.5, 1, 0}, {0.5, -1, 0}, {0.5, 0, 1}, {0, 2, 0}, {1, 2, 0}};
+        for (int i = 0; i < 7; ++i)
+            v[i].P() = vcg::Point3d(xyz[i][0], xyz[i][1], xyz[i][2]);
+        for (const auto& f : faces)
+            vcg::tri::Allocator<CoreMesh>::AddFace(m, &m.vert[size_t(f[0])], &m.vert[size_t(f[1])], &m.vert[size_t(f[2])]);
+    };
+    CoreMesh fin;
+    build(fin, {{0, 1, 2}, {1, 0, 3}, {0, 1, 4}});
+    auto r = ManifoldCheck::Repair(fin);
+    EXPECT_GE(r.faces_removed, 1u);
+    EXPECT_TRUE(r.manifold);
+    EXPECT_EQ(test::Check(fin).non_manifold_edges, 0);
+
+    CoreMesh bowTie;
+    build(bowTie, {{0, 1, 2}, {1, 0, 3}, {2, 6, 5}});
+    r = ManifoldCheck::Repair(bowTie);
+    EXPECT_EQ(r.faces_removed, 0u);
+    EXPECT_EQ(r.vertices_split, 1u);
+    EXPECT_TRUE(r.manifold && r.oriented);
+    EXPECT_EQ(bowTie.face.size(), 3u);
+
+    CoreMesh flipped;  // one face turned against its neighbour: reported, not hidden
+    build(flipped, {{0, 1, 2}, {0, 1, 3}});
+    r = ManifoldCheck::Repair(flipped);
+    EXPECT_TRUE(r.manifold);
+    EXPECT_FALSE(r.oriented);
 }

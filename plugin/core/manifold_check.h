@@ -1,0 +1,47 @@
+#pragma once
+/// \file manifold_check.h
+/// The pipeline's last guarantee: the surface is an oriented 2-manifold with boundary. Pinch
+/// resolution (pinches.h) stops after a few passes and the boundary steps move vertices, so
+/// the result is checked, not assumed: an edge shared by more than two faces loses its extra
+/// faces, a vertex where separate fans meet is split into one per fan (VCGlib's Clean), and
+/// what still fails is reported, so that the caller refuses instead of returning a broken mesh.
+
+#include "mesh.h"
+
+#include <vcg/complex/algorithms/clean.h>
+
+namespace ib {
+
+class ManifoldCheck
+{
+public:
+    struct Result
+    {
+        size_t faces_removed = 0;   ///< faces on edges shared by more than two faces
+        size_t vertices_split = 0;  ///< vertices where separate fans met, split into one per fan
+        bool manifold = true;       ///< after the repairs: every edge and vertex a 2-manifold's
+        bool oriented = true;       ///< after the repairs: neighbouring faces agree on their orientation
+    };
+
+    /// Checks and repairs `mesh` in place (compacted, face-face adjacency rebuilt).
+    static Result Repair(CoreMesh& mesh)
+    {
+        using Clean = vcg::tri::Clean<CoreMesh>;
+        Result r;
+        vcg::tri::UpdateTopology<CoreMesh>::FaceFace(mesh);
+        if (Clean::CountNonManifoldEdgeFF(mesh) > 0) {
+            r.faces_removed = size_t(Clean::RemoveNonManifoldFace(mesh));
+            vcg::tri::Allocator<CoreMesh>::CompactEveryVector(mesh);
+            vcg::tri::UpdateTopology<CoreMesh>::FaceFace(mesh);
+        }
+        if (Clean::CountNonManifoldVertexFF(mesh, false, false) > 0) {
+            r.vertices_split = size_t(Clean::SplitNonManifoldVertex(mesh, 0));
+            vcg::tri::UpdateTopology<CoreMesh>::FaceFace(mesh);
+        }
+        r.manifold = Clean::CountNonManifoldEdgeFF(mesh) == 0 && Clean::CountNonManifoldVertexFF(mesh, false, false) == 0;
+        r.oriented = Clean::IsCoherentlyOrientedMesh(mesh);
+        return r;
+    }
+};
+
+} // namespace ib
