@@ -29,7 +29,7 @@ public:
         using Clean = vcg::tri::Clean<CoreMesh>;
         Result r;
         vcg::tri::UpdateTopology<CoreMesh>::FaceFace(mesh);
-        if (Clean::CountNonManifoldEdgeFF(mesh) > 0) {
+        if (NonManifoldEdges(mesh) > 0) {
             r.faces_removed = size_t(Clean::RemoveNonManifoldFace(mesh));
             vcg::tri::Allocator<CoreMesh>::CompactEveryVector(mesh);
             vcg::tri::UpdateTopology<CoreMesh>::FaceFace(mesh);
@@ -38,9 +38,21 @@ public:
             r.vertices_split = size_t(Clean::SplitNonManifoldVertex(mesh, 0));
             vcg::tri::UpdateTopology<CoreMesh>::FaceFace(mesh);
         }
-        r.manifold = Clean::CountNonManifoldEdgeFF(mesh) == 0 && Clean::CountNonManifoldVertexFF(mesh, false, false) == 0;
+        r.manifold = NonManifoldEdges(mesh) == 0 && Clean::CountNonManifoldVertexFF(mesh, false, false) == 0;
         r.oriented = Clean::IsCoherentlyOrientedMesh(mesh);
         return r;
+    }
+
+private:
+    /// Face edges whose face-face ring is not a 2-manifold's. (Clean::CountNonManifoldEdgeFF
+    /// takes three user bit flags, the third of which overflows CoreFace's flag word.)
+    static size_t NonManifoldEdges(const CoreMesh& mesh)
+    {
+        size_t count = 0;
+        for (const CoreFace& f : mesh.face)
+            for (int e = 0; e < 3; ++e)
+                count += !f.IsD() && !vcg::face::IsManifold(f, e);
+        return count;
     }
 };
 
