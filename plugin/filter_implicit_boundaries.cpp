@@ -131,18 +131,26 @@ ib::Points facingMatrix(const std::vector<const MeshModel*>& layers, const std::
 			++used.cameras;
 		}
 		else if (m->cm.fn > 0) {
-			// Area-weighted normals of the triangles around each vertex, through the matrix as
-			// normals go (vertexMatrix).
-			CMeshO grid;
-			vcg::tri::Append<CMeshO, CMeshO>::MeshCopyConst(grid, m->cm);
-			vcg::tri::Allocator<CMeshO>::CompactEveryVector(grid);
-			for (auto& v : grid.vert)
-				v.N() = Point3m(0, 0, 0);
-			for (auto& f : grid.face)
+			// Area-weighted normals of the triangles around each vertex (rows skip deleted
+			// vertices, as vertexMatrix's), through the matrix's inverse transpose as normals go.
+			std::vector<Eigen::Index> rowOf(m->cm.vert.size(), -1);
+			Eigen::Index next = 0;
+			for (size_t i = 0; i < m->cm.vert.size(); ++i)
+				if (!m->cm.vert[i].IsD())
+					rowOf[i] = next++;
+			ib::Points sum = ib::Points::Zero(m->cm.vn, 3);
+			for (const auto& f : m->cm.face) {
+				if (f.IsD())
+					continue;
+				const Point3m n = vcg::TriangleNormal(f);
 				for (int k = 0; k < 3; ++k)
-					f.V(k)->N() += vcg::TriangleNormal(f);
-			grid.Tr = m->cm.Tr;
-			out.middleRows(row, m->cm.vn) = vertexMatrix(grid, true);
+					sum.row(rowOf[size_t(vcg::tri::Index(m->cm, f.cV(k)))]) += Eigen::RowVector3d(n[0], n[1], n[2]);
+			}
+			Eigen::Matrix3d linear;
+			for (int i = 0; i < 3; ++i)
+				for (int j = 0; j < 3; ++j)
+					linear(i, j) = double(m->cm.Tr.ElementAt(i, j));
+			out.middleRows(row, m->cm.vn) = sum * linear.inverse();  // rows: (M^-T n)^T = n^T M^-1
 			++used.triangles;
 		}
 		else if (viewpoint) {

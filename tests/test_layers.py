@@ -293,6 +293,18 @@ def test_estimated_normals_follow_the_range_grids_triangles(plugin):
     ms.add_mesh(pymeshlab.Mesh(vertex_matrix=vertices, face_matrix=faces), "range grid")
     implicit_boundaries.apply(ms, normals="Estimate")
     assert inward_fraction(ms.current_mesh()) > 0.99
+    # The same grid placed by a matrix (turned, stretched, moved): the triangles still decide.
+    matrix = np.eye(4)
+    matrix[:3, :3] = rotation_about_z(50) @ np.diag([1.5, 1, 1])
+    matrix[:3, 3] = [2, 0, 0]
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=vertices, face_matrix=faces), "range grid")
+    ms.set_matrix(transformmatrix=matrix, freeze=False)
+    implicit_boundaries.apply(ms, normals="Estimate")
+    moved = ms.current_mesh()
+    v, f = moved.vertex_matrix() - matrix[:3, 3], moved.face_matrix()
+    normal = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
+    assert (np.sum(normal * v[f].mean(axis=1), axis=1) < 0).mean() > 0.99
     ms = pymeshlab.MeshSet()
     ms.add_mesh(pymeshlab.Mesh(vertex_matrix=vertices), "points")
     implicit_boundaries.apply(ms, normals="Estimate")
