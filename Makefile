@@ -9,7 +9,7 @@ JOBS   ?= $(shell nproc)
 SANITIZE_BUILD ?= build-sanitize
 FUZZ_EXAMPLES  ?= 400
 
-.PHONY: all deps plugin demo test test-core test-python test-sanitize fuzz test-gui gui clean
+.PHONY: all deps plugin demo wheel test test-core test-python test-sanitize fuzz test-gui gui clean
 
 all: plugin
 
@@ -25,6 +25,12 @@ plugin: deps $(BUILD)/CMakeCache.txt
 
 demo: plugin
 	$(PYTHON) -m implicit_boundaries demo
+
+# A platform wheel with the double plugin inside: `pip install dist/implicit_boundaries-*.whl`
+# where pymeshlab 2025.7.post1 installs (it pulls it in) gives the package and the command line.
+wheel: plugin
+	$(PYTHON) -m pip wheel -q --no-deps -w dist ./python
+	@ls dist/implicit_boundaries-*.whl
 
 test-core: plugin
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
@@ -60,4 +66,4 @@ gui: plugin
 test: test-core test-python gui test-sanitize
 
 clean:
-	rm -rf $(BUILD) $(SANITIZE_BUILD) python/implicit_boundaries/lib
+	rm -rf $(BUILD) $(SANITIZE_BUILD) python/implicit_boundaries/lib python/build dist
