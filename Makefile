@@ -3,13 +3,18 @@
 #   make test   the same setup, then every test (C++ core, Python/pymeshlab, GUI load check,
 #               the core's tests again under AddressSanitizer + UndefinedBehaviorSanitizer)
 #   make fuzz   many more random inputs through the filter than the bounded run in make test
+#   make wheel  dist/implicit_boundaries-*.whl, the Python package with the double plugin inside
+#   make install-plugin MESHLAB=<folder of the meshlab binary>   the plugin that fits that MeshLab
 PYTHON ?= python3
 BUILD  ?= build
 JOBS   ?= $(shell nproc)
 SANITIZE_BUILD ?= build-sanitize
+FLOAT_BUILD    ?= build-float
+DOUBLE_PLUGIN  := python/implicit_boundaries/lib/libfilter_implicit_boundaries.so
+FLOAT_PLUGIN   := $(FLOAT_BUILD)/meshlab-2025.07/libfilter_implicit_boundaries.so
 FUZZ_EXAMPLES  ?= 400
 
-.PHONY: all deps plugin demo wheel test test-core test-python test-sanitize fuzz test-gui gui clean
+.PHONY: all deps plugin plugin-float demo wheel install-plugin test test-core test-python test-sanitize fuzz gui gui-double clean
 
 all: plugin
 
@@ -22,6 +27,14 @@ $(BUILD)/CMakeCache.txt: | deps
 
 plugin: deps $(BUILD)/CMakeCache.txt
 	cmake --build $(BUILD) -j $(JOBS)
+
+# The float plugin, for MeshLab 2025.07 (the build most people run): linked against the
+# libmeshlab-common.so of a float MeshLab built from the same sources (cached, .ci/meshlab-gui).
+plugin-float: deps
+	.ci/install-deps gui
+	cmake -S . -B $(FLOAT_BUILD) -G Ninja -DIB_SCALAR=float -DIB_BUILD_TESTS=OFF -DMESHLAB_SOURCE_DIR="$$(.ci/meshlab-source)" \
+	  -DMESHLAB_COMMON_LIB="$$(.ci/meshlab-gui float)/libmeshlab-common.so"
+	cmake --build $(FLOAT_BUILD) -j $(JOBS)
 
 demo: plugin
 	$(PYTHON) -m implicit_boundaries demo
@@ -53,17 +66,27 @@ test-sanitize:
 fuzz: plugin
 	IB_FUZZ_PROFILE=fuzz IB_FUZZ_EXAMPLES=$(FUZZ_EXAMPLES) $(PYTHON) -m pytest -q tests/test_fuzz.py
 
-# Builds MeshLab 2025.07d (cached outside the repo), checks that it loads our plugin and runs it
-# from the Filters menu: on one scan, then on two aligned scans of an .aln project merged.
-gui: plugin
-	.ci/install-deps gui
-	tests/gui/apply_filter_in_meshlab.sh "$$(.ci/meshlab-gui)" python/implicit_boundaries/lib/libfilter_implicit_boundaries.so
-	tests/gui/merge_layers_in_meshlab.sh "$$(.ci/meshlab-gui)" python/implicit_boundaries/lib/libfilter_implicit_boundaries.so
-	@echo "Start MeshLab with the plugin: $$(.ci/meshlab-gui)/meshlab"
+# Builds MeshLab 2025.07 (float; cached outside the repo) and tests the float plugin in it:
+# installed from Help > Plugin Info > Load Plugins and found after a restart, then run from the
+# Filters menu on one scan, then on two aligned scans of an .aln project merged. gui-double: the same with MeshLab 2025.07d and the double plugin (pymeshlab's).
+gui: plugin-float
+	tests/gui/load_plugin_from_dialog_in_meshlab.sh "$$(.ci/meshlab-gui float)" $(FLOAT_PLUGIN) out/gui-load-plugin
+	tests/gui/apply_filter_in_meshlab.sh "$$(.ci/meshlab-gui float)" $(FLOAT_PLUGIN) out/gui
+	tests/gui/merge_layers_in_meshlab.sh "$$(.ci/meshlab-gui float)" $(FLOAT_PLUGIN) out/gui-merge
+	@echo "Start MeshLab with the plugin: $$(.ci/meshlab-gui float)/meshlab"
 	@echo "then Filters > Remeshing, Simplification and Reconstruction > Implicit reconstruction with boundaries"
 
+gui-double: plugin
+	.ci/install-deps gui
+	tests/gui/apply_filter_in_meshlab.sh "$$(.ci/meshlab-gui double)" $(DOUBLE_PLUGIN) out/gui-double
+	tests/gui/merge_layers_in_meshlab.sh "$$(.ci/meshlab-gui double)" $(DOUBLE_PLUGIN) out/gui-double-merge
 
-test: test-core test-python gui test-sanitize
+# Copies the plugin that fits the MeshLab in $(MESHLAB) (its precision, read from its
+# libmeshlab-common.so) into that MeshLab's plugins folder.
+install-plugin: plugin plugin-float
+	.ci/install-plugin "$(MESHLAB)" $(DOUBLE_PLUGIN) $(FLOAT_PLUGIN)
+
+test: test-core test-python gui gui-double test-sanitize
 
 clean:
-	rm -rf $(BUILD) $(SANITIZE_BUILD) python/implicit_boundaries/lib python/build dist
+	rm -rf $(BUILD) $(SANITIZE_BUILD) $(FLOAT_BUILD) python/implicit_boundaries/lib python/build dist

@@ -679,3 +679,9 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 }
 
 MESHLAB_PLUGIN_NAME_EXPORTER(FilterImplicitBoundariesPlugin)
+
+// Which MeshLab this file fits, readable from the file without loading it: `implicit-boundaries
+// info` and the Python loader say so instead of MeshLab's bare "different floating point
+// precision" when a user picks the wrong one.
+extern "C" Q_DECL_EXPORT const char implicit_boundaries_build[] =
+	"implicit_boundaries plugin for MeshLab " meshlab_xstr(MESHLAB_VERSION) " scalar=" meshlab_xstr(MESHLAB_SCALAR);

@@ -5,6 +5,7 @@ import numpy as np
 import pymeshlab
 import pytest
 
+import implicit_boundaries
 from implicit_boundaries.cli import DEMO_SCAN, main
 from shapes import fibonacci_sphere
 from test_compare import two_holed_sphere
@@ -136,7 +137,25 @@ def test_bad_parameter_is_reported_not_raised(tmp_path, capsys, plugin):
 
 def test_info_reports_the_plugin(capsys, plugin):
     assert main(["info"]) == 0
-    assert "loads" in capsys.readouterr().out
+    out = capsys.readouterr().out
+    assert "built for MeshLab 2025.07d (double)" in out and "loads" in out
+
+
+def test_a_plugin_of_the_other_precision_is_named_not_loaded(tmp_path, capsys, plugin, monkeypatch):
+    """The float plugin (for the MeshLab 2025.07 GUI) given to pymeshlab: info and load() say
+    which MeshLab the file fits and which one to use. Made from the double module by changing
+    its build tag (the float module is built by `make gui`)."""
+    module = implicit_boundaries.plugin_path().read_bytes()
+    assert module.count(b"scalar=double") == 1
+    fake = tmp_path / "libfilter_implicit_boundaries.so"
+    fake.write_bytes(module.replace(b"scalar=double", b"scalar=float\0"))
+    monkeypatch.setenv("IMPLICIT_BOUNDARIES_PLUGIN", str(fake))
+    assert main(["info"]) == 1
+    out = capsys.readouterr().out
+    assert "built for MeshLab 2025.07 (float)" in out
+    assert "embeds MeshLab 2025.07d (double): use the double plugin" in out
+    with pytest.raises(OSError, match=r"built for MeshLab 2025.07 \(float\)"):
+        implicit_boundaries.load()
 
 
 def test_options_reach_the_filter(tmp_path, capsys, plugin):

@@ -1,11 +1,35 @@
 """Finding the compiled MeshLab plugin and loading it into pymeshlab."""
 import os
+import re
 from pathlib import Path
+from typing import Optional, Tuple
 
 import pymeshlab
 
 FILTER_NAME = "generate_surface_reconstruction_implicit_with_boundaries"
 PLUGIN_FILE = "libfilter_implicit_boundaries.so"
+# pymeshlab 2025.7.post1 embeds MeshLab 2025.07d: the double build.
+PYMESHLAB_MESHLAB = ("2025.07", "double")
+
+
+class PluginMismatchError(OSError):
+    """The plugin file was built for another MeshLab (version or scalar type) than pymeshlab's."""
+
+
+def plugin_build(path) -> Optional[Tuple[str, str]]:
+    """(MeshLab version, scalar type) the plugin file was built for, e.g. ("2025.07", "float"),
+    read from the file's build tag without loading it; None when the file has no tag."""
+    tag = re.search(rb"implicit_boundaries plugin for MeshLab ([0-9.]+) scalar=(float|double)",
+                    Path(path).read_bytes())
+    return (tag.group(1).decode(), tag.group(2).decode()) if tag else None
+
+
+def describe_build(build: Optional[Tuple[str, str]]) -> str:
+    """'MeshLab 2025.07 (float)' or 'MeshLab 2025.07d (double)' for a plugin_build() result."""
+    if build is None:
+        return "an unknown MeshLab (the file has no build tag: is it this project's plugin?)"
+    version, scalar = build
+    return f"MeshLab {version}{'d' if scalar == 'double' else ''} ({scalar})"
 
 
 def plugin_path() -> Path:
@@ -49,6 +73,13 @@ def load() -> Path:
     method is bound here.
     """
     path = plugin_path()
+    build = plugin_build(path)
+    if build != PYMESHLAB_MESHLAB:
+        raise PluginMismatchError(
+            f"the plugin {path} is built for {describe_build(build)}; pymeshlab 2025.7.post1 embeds "
+            f"{describe_build(PYMESHLAB_MESHLAB)}: use the double plugin "
+            "('make plugin' builds it into python/implicit_boundaries/lib; the wheel carries it). "
+            "The float one is for the MeshLab 2025.07 GUI")
     if FILTER_NAME not in pymeshlab.filter_list():
         pymeshlab.load_plugin(str(path))
     if not hasattr(pymeshlab.MeshSet, FILTER_NAME):

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import pymeshlab
 
-from ._plugin import FILTER_NAME, apply, load
+from ._plugin import FILTER_NAME, PluginMismatchError, apply, describe_build, load, plugin_build, plugin_path
 from .alignment import read_alignment
 from .compare import compare
 from .reconstruct import loops_from_result
@@ -164,8 +164,9 @@ def cmd_info(args) -> int:
         except metadata.PackageNotFoundError:
             print(f"{name}: not installed (compare --report needs it)")
     try:
+        print(f"plugin {plugin_path()}: built for {describe_build(plugin_build(plugin_path()))}")
         path = load()
-    except (FileNotFoundError, pymeshlab.PyMeshLabException) as e:  # diagnose, don't crash
+    except (FileNotFoundError, PluginMismatchError, pymeshlab.PyMeshLabException) as e:  # diagnose, don't crash
         print(f"plugin: not loadable: {e}")
         return 1
     print(f"plugin {path}: loads, filter '{FILTER_NAME}' available")

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The filter used as a MeshLab user does, in MeshLab 2025.07d built from the same sources:
+# The filter used as a MeshLab user does, in MeshLab 2025.07 or 2025.07d (the plugin of its precision) built from the same sources:
 # installs the module into its plugins/ folder, starts MeshLab under Xvfb on a point cloud
 # (pymeshlab's bunny scan, vertices and normals only), checks that the module stays mapped in
 # the MeshLab process (MeshLab unloads plugins that fail its checks) and that no error dialog

@@ -1,14 +1,16 @@
-# Steps shared by the GUI tests, sourced by them (not run on its own): MeshLab 2025.07d under
+# Steps shared by the GUI tests, sourced by them (not run on its own): MeshLab 2025.07 (float)
+# or 2025.07d (double), whichever folder is given, under
 # Xvfb, driven with xdotool. No window manager runs, so windows sit where MeshLab puts them and
 # menus are opened with the mouse. MeshLab echoes its log window on stderr: $work/meshlab.log.
 
-# gui_init DISTRIB PLUGIN_SO OUT_DIR: installs the module into MeshLab's plugins/ folder, makes
-# OUT_DIR and a temporary $work folder (removed on exit, with the processes started here).
+# gui_init DISTRIB PLUGIN_SO OUT_DIR: installs the module into MeshLab's plugins/ folder (an
+# empty PLUGIN_SO: removes it from there), makes OUT_DIR and a temporary $work folder (removed
+# on exit, with the processes started here).
 gui_init() {
   distrib=$1
   out=$3
   mkdir -p "$out"
-  cp "$2" "$distrib/plugins/"
+  if [ -n "$2" ]; then cp "$2" "$distrib/plugins/"; else rm -f "$distrib/plugins/libfilter_implicit_boundaries.so"; fi
   work=$(mktemp -d)
   trap gui_cleanup EXIT
 }
@@ -34,6 +36,19 @@ gui_start() {
   if timeout 60 xdotool search --sync --name '^Send Anonymous Statistics' >/dev/null; then
     sleep 1; xdotool key alt+n
   fi
+  gui_wait_for_window
+}
+
+# gui_restart FILE: closes MeshLab and starts it again on FILE, same display and settings
+# (the first-start question was answered).
+gui_restart() {
+  kill "$meshlab"; wait "$meshlab" 2>/dev/null || true
+  "$distrib/meshlab" "$1" >"$work/meshlab.log" 2>&1 &
+  meshlab=$!
+  gui_wait_for_window
+}
+
+gui_wait_for_window() {
   window=$(timeout 60 xdotool search --sync --onlyvisible --name '^MeshLab 20' | head -n1)
   sleep 5  # let the file finish loading
 }

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Several aligned range scans merged in the MeshLab GUI, in MeshLab 2025.07d built from the same
+# Several aligned range scans merged in the MeshLab GUI, in MeshLab 2025.07 or 2025.07d built from the same
 # sources: makes two overlapping scans of the unit sphere (a Fibonacci sphere's points, normals
 # outward), "upper" z > -0.2 and "lower" z < 0.2, the lower one stored in its own scanner frame
 # and placed by its matrix M in a MeshLab .aln project (upper: the identity). Starts MeshLab
