@@ -68,10 +68,12 @@ fuzz: plugin
 
 # Builds MeshLab 2025.07 (float; cached outside the repo) and tests the float plugin in it:
 # installed from Help > Plugin Info > Load Plugins and found after a restart, then run from the
-# Filters menu on one scan, then on two aligned scans of an .aln project merged. gui-double: the same with MeshLab 2025.07d and the double plugin (pymeshlab's).
+# Filters menu on one scan (its surface exported and compared with pymeshlab's, made with the
+# double plugin: same loops, within 1e-4 of the diagonal), then on two aligned scans merged. gui-double: the same with MeshLab 2025.07d and the double plugin (pymeshlab's).
 gui: plugin-float
 	tests/gui/load_plugin_from_dialog_in_meshlab.sh "$$(.ci/meshlab-gui float)" $(FLOAT_PLUGIN) out/gui-load-plugin
 	tests/gui/apply_filter_in_meshlab.sh "$$(.ci/meshlab-gui float)" $(FLOAT_PLUGIN) out/gui
+	$(PYTHON) tests/gui/same_surface.py out/gui/result.ply
 	tests/gui/merge_layers_in_meshlab.sh "$$(.ci/meshlab-gui float)" $(FLOAT_PLUGIN) out/gui-merge
 	@echo "Start MeshLab with the plugin: $$(.ci/meshlab-gui float)/meshlab"
 	@echo "then Filters > Remeshing, Simplification and Reconstruction > Implicit reconstruction with boundaries"
@@ -79,6 +81,7 @@ gui: plugin-float
 gui-double: plugin
 	.ci/install-deps gui
 	tests/gui/apply_filter_in_meshlab.sh "$$(.ci/meshlab-gui double)" $(DOUBLE_PLUGIN) out/gui-double
+	$(PYTHON) tests/gui/same_surface.py out/gui-double/result.ply
 	tests/gui/merge_layers_in_meshlab.sh "$$(.ci/meshlab-gui double)" $(DOUBLE_PLUGIN) out/gui-double-merge
 
 # Copies the plugin that fits the MeshLab in $(MESHLAB) (its precision, read from its

@@ -5,8 +5,10 @@
 # the MeshLab process (MeshLab unloads plugins that fail its checks) and that no error dialog
 # opened, opens Filters > Remeshing, Simplification and Reconstruction > Implicit reconstruction
 # with boundaries, presses Apply, and checks MeshLab's log (it echoes its log window on
-# stderr) for the filter's report and the new layer. Screenshots of the menu, the dialog and
-# the result are kept in OUT_DIR as the test's artefacts.
+# stderr) for the filter's report and the new layer, then exports the new layer as
+# OUT_DIR/result.ply (File > Export Mesh As: tests/gui/same_surface.py compares the float and
+# the double MeshLab's). Screenshots of the menu, the dialog and the result are kept in OUT_DIR
+# as the test's artefacts.
 # Usage: apply_filter_in_meshlab.sh MESHLAB_DISTRIB_DIR PLUGIN_SO [OUT_DIR]
 set -euo pipefail
 . "$(dirname "$0")/common.sh"
@@ -30,5 +32,6 @@ gui_apply_and_close
 report=$(gui_surface_report)
 faces=$(echo "$report" | gui_surface_field 1)
 if [ "$faces" -lt 10000 ]; then echo "FAIL: only $faces faces: $report"; exit 1; fi
+gui_export_current "$(cd "$out" && pwd)/result.ply"
 echo "MeshLab ran the filter from its menu: $report"
-echo "screenshots: $out/filters_menu.png $out/filter_dialog.png $out/result.png"
+echo "screenshots: $out/filters_menu.png $out/filter_dialog.png $out/result.png; surface: $out/result.ply"

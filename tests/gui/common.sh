@@ -102,6 +102,21 @@ gui_apply_and_close() {
   fi
 }
 
+# gui_export_current FILE: File > Export Mesh As..., FILE typed into the file dialog, the saving
+# options accepted as they are (binary PLY); fails when FILE was not written.
+gui_export_current() {
+  # "Export Mesh As..." is the File menu's ninth row.
+  xdotool mousemove 35 10 click 1; sleep 1
+  xdotool mousemove 100 211; sleep 0.5; xdotool mousemove 105 211 click 1
+  timeout 30 xdotool search --sync --onlyvisible --name '^Save .* Layer$' >/dev/null ||
+    { echo "FAIL: the export dialog did not open"; exit 1; }
+  sleep 1; xdotool type --delay 20 "$1"; xdotool key Return
+  timeout 30 xdotool search --sync --onlyvisible --name '^Choose Saving Options' >/dev/null ||
+    { echo "FAIL: the saving options did not open"; exit 1; }
+  sleep 1; xdotool key Return; sleep 2
+  [ -s "$1" ] || { echo "FAIL: MeshLab did not write $1"; exit 1; }
+}
+
 # gui_surface_report: the filter's "Surface: F faces, V vertices; L boundary loops kept ..."
 # line from MeshLab's log (fails when there is none); gui_surface_field N picks a number of it
 # (1 faces, 2 vertices, 3 loops).
