@@ -16,13 +16,17 @@ gui_init "$1" "$2" "${3:-out/gui}"
 
 scan="$work/bunny_points.ply"
 python3 - "$scan" <<'PY'
-import os, sys, pymeshlab
+# Written as float32 by hand: the float and the double MeshLab then read the same values (a
+# double PLY would reach the float one rounded), which tests/gui/same_surface.py also uses.
+import os, sys, numpy as np, pymeshlab
 ms = pymeshlab.MeshSet()
 ms.load_new_mesh(os.path.join(os.path.dirname(pymeshlab.__file__), "tests", "sample_meshes", "bunny10k_textured.obj"))
 m = ms.current_mesh()
-points = pymeshlab.MeshSet()
-points.add_mesh(pymeshlab.Mesh(vertex_matrix=m.vertex_matrix(), v_normals_matrix=m.vertex_normal_matrix()), "bunny points")
-points.save_current_mesh(sys.argv[1], save_vertex_color=False, save_vertex_normal=True)
+rows = np.hstack([m.vertex_matrix(), m.vertex_normal_matrix()]).astype("<f4")
+with open(sys.argv[1], "wb") as f:
+    f.write((f"ply\nformat binary_little_endian 1.0\nelement vertex {len(rows)}\n" +
+             "".join(f"property float {c}\n" for c in ("x", "y", "z", "nx", "ny", "nz")) + "end_header\n").encode())
+    f.write(rows.tobytes())
 PY
 
 gui_start "$scan"

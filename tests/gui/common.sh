@@ -105,6 +105,7 @@ gui_apply_and_close() {
 # gui_export_current FILE: File > Export Mesh As..., FILE typed into the file dialog, the saving
 # options accepted as they are (binary PLY); fails when FILE was not written.
 gui_export_current() {
+  rm -f "$1"  # else MeshLab asks whether to overwrite it
   # "Export Mesh As..." is the File menu's ninth row.
   xdotool mousemove 35 10 click 1; sleep 1
   xdotool mousemove 100 211; sleep 0.5; xdotool mousemove 105 211 click 1

@@ -1,9 +1,9 @@
 """The surface a MeshLab GUI made from pymeshlab's bunny scan (apply_filter_in_meshlab.sh's
 exported result.ply) against the one pymeshlab makes with the double plugin from the same
-samples (rounded to float, as the scan file the GUI opened holds them): the same boundary
-loops, and every vertex of each within 1e-4 of the bounding-box diagonal of the other. Run after
-the GUI test of the float MeshLab (and of the double one): the float plugin must give what the
-double one gives.
+samples (rounded to float32, as apply_filter_in_meshlab.sh writes the scan file the GUI opens):
+the same boundary loops, and every vertex of each within 1e-4 of the bounding-box diagonal of
+the other. Run after the GUI test of the float MeshLab (and of the double one): the float
+plugin must give what the double one gives.
 
     python tests/gui/same_surface.py out/gui/result.ply
 """
