@@ -1,0 +1,100 @@
+"""Large scans, where the automatic resolution's cap makes the lattice coarser than the sampling
+(issue: boundaries on unseen scans, kind 7). Random samples (not a mesh's vertices) of a smooth
+open surface with one boundary (tests/shapes.py `wavy_cap`: the unit sphere above z = -0.2,
+its radius times 1 + 0.03 sin 8x sin 8y, with exact normals), at several sizes, each at the
+automatic resolution and at a hand-set lattice `--coarser` times coarser than the sampling.
+Each run in its own process, so its peak resident memory is its own.
+
+    python bench/large_scan.py [--sizes 100000 1000000 5000000 10000000] [--coarser 4]
+"""
+import argparse
+import json
+import resource
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pymeshlab
+from scipy.spatial import cKDTree
+
+import implicit_boundaries
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
+import shapes  # noqa: E402
+
+
+def spacing_estimate(points):
+    """The filter's spacing measure, sqrt(area per sample) from 8 neighbours, on a subsample."""
+    r8 = cKDTree(points).query(points[:: max(1, len(points) // 2000)], k=9)[0][:, 8]
+    return float(np.median(np.sqrt(np.pi * r8 ** 2 / 8)))
+
+
+def one(n, coarser):
+    """One filter call in this process: its loops, surface error and figures. Memory: the
+    process's peak resident size, and its size before the call with the point layer loaded
+    (the filter's own share is the difference, what its memory estimate is for)."""
+    points, normals = shapes.wavy_cap(n)
+    resolution = 0
+    if coarser:
+        resolution = int(round(np.ptp(points, axis=0).max() / (coarser * spacing_estimate(points))))
+    implicit_boundaries.load()
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=points, v_normals_matrix=normals), "samples")
+    del points, normals
+    before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    t = time.perf_counter()
+    info = implicit_boundaries.apply(ms, resolution=resolution)
+    seconds = time.perf_counter() - t
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    vertices = ms.current_mesh().vertex_matrix()
+    loops = implicit_boundaries.loops_from_result(info)
+    u = vertices / np.linalg.norm(vertices, axis=1, keepdims=True)
+    radius = 1 + 0.03 * np.sin(8 * u[:, 0]) * np.sin(8 * u[:, 1])
+    error = np.abs(np.linalg.norm(vertices, axis=1) - radius)
+    return {"seconds": seconds, "peak_gb": peak / 2 ** 20, "before_gb": before / 2 ** 20,
+            "resolution": int(info["resolution"]), "spacing": float(info["sample_spacing"]),
+            "cell": float(info["cell_size"]), "loops": len(loops),
+            "largest": sorted((len(loop) for loop in loops), reverse=True)[:4],
+            "max_error_spacings": float(error.max() / info["sample_spacing"]),
+            "faces": int(info["surface_faces"]), "sods_cells": int(info["sods_cells"]),
+            "memory_estimate_gb": float(info.get("memory_estimate_gb", float("nan")))}
+
+
+def child(n, coarser):
+    done = subprocess.run([sys.executable, __file__, "--one", str(n), str(coarser)], capture_output=True, text=True)
+    if done.returncode != 0:
+        return {"error": (done.stderr.strip().splitlines() or ["failed"])[-1]}
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p.add_argument("--sizes", type=int, nargs="+", default=[100_000, 1_000_000, 5_000_000, 10_000_000])
+    p.add_argument("--coarser", type=float, default=4.0,
+                   help="the hand-set lattice's cell in sample spacings (0: only the automatic resolution)")
+    p.add_argument("--one", nargs=2, help=argparse.SUPPRESS)
+    args = p.parse_args(argv)
+    if args.one:
+        print(json.dumps(one(int(args.one[0]), float(args.one[1]))))
+        return
+    print("| samples | lattice | resolution | cell / spacing | loops (true: 1) | largest loops "
+          "| farthest vertex from the surface (spacings) | time (s) | SODS cells | peak memory (GB) "
+          "| filter's share: peak - before (GB) | its estimate (GB) |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+    for n in args.sizes:
+        for coarser in [0.0] + ([args.coarser] if args.coarser else []):
+            r = child(n, coarser)
+            label = "automatic" if not coarser else f"{coarser:g}x coarser than the spacing"
+            if "error" in r:
+                print(f"| {n:,} | {label} | {r['error']} ||||||||||", flush=True)
+                continue
+            print(f"| {n:,} | {label} | {r['resolution']} | {r['cell'] / r['spacing']:.2f} | {r['loops']} "
+                  f"| {r['largest']} | {r['max_error_spacings']:.2f} | {r['seconds']:.1f} | {r['sods_cells']:,} "
+                  f"| {r['peak_gb']:.2f} (before {r['before_gb']:.2f}) | {r['peak_gb'] - r['before_gb']:.2f} "
+                  f"| {r['memory_estimate_gb']:.2f} |", flush=True)
+
+
+if __name__ == "__main__":
+    main()
