@@ -612,9 +612,12 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 		r.lattice_cells[0], r.lattice_cells[1], r.lattice_cells[2], r.cell_size, r.resolution,
 		r.resolution_automatic ? ", automatic" : "", r.sample_spacing);
 	if (r.resolution_automatic && r.resolution == ib::Reconstruction::kMaxAutoResolution)
-		log("Warning: the automatic resolution was capped at %d; the samples are far apart relative "
-			"to their spacing (separate clusters?). Set the resolution by hand if the result is too coarse.",
-			r.resolution);
+		log("Warning: the automatic resolution was capped at %d: the longest side of the samples' box is %.0f "
+			"sample spacings, which asks for %d cells; cells are %.2f spacings wide, so detail under a cell "
+			"is smoothed. A large, dense scan or parts far apart cause this; a resolution set by hand (up "
+			"to %d) gives finer cells, with more memory.",
+			r.resolution, r.resolution_from_spacing * ib::Reconstruction::kCellPerSpacing,
+			r.resolution_from_spacing, r.cell_size / r.sample_spacing, ib::Reconstruction::kMaxResolution);
 	log("Surface: %d faces, %d vertices; %d boundary loops kept (edges: %s); %d small holes "
 		"filled (loops under %d edges); %zu unsupported faces trimmed off the boundary, %zu "
 		"boundary vertices fitted to the samples' edge.",
@@ -658,6 +661,7 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 	res["surface_faces"] = out->cm.fn;
 	res["surface_vertices"] = out->cm.vn;
 	res["resolution"] = r.resolution;
+	res["resolution_from_spacing"] = r.resolution_from_spacing;
 	res["cell_size"] = double(r.cell_size);
 	res["sample_spacing"] = double(r.sample_spacing);
 	res["implicit"] = int(p.implicit);
@@ -667,6 +671,7 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 	res["full_lattice_evaluations"] = double(r.lattice_corners);
 	res["crossed_cell_corners"] = double(r.crossed_corners);
 	res["memory_limit_gb"] = r.memory_limit / 1e9;
+	res["memory_estimate_gb"] = r.memory_estimate / 1e9;
 	res["normals_estimated"] = r.normals_estimated;
 	res["normals_turned"] = double(r.normals_turned);
 	res["normals_filled"] = double(r.normals_filled);

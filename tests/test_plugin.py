@@ -6,6 +6,7 @@ from scipy.spatial import cKDTree
 
 import implicit_boundaries
 from conftest import SAMPLES, point_cloud
+from shapes import fibonacci_sphere
 from implicit_boundaries.metrics import boundary_vertex_sets, match_loops
 
 FILTER = implicit_boundaries.FILTER_NAME
@@ -164,6 +165,21 @@ def test_resolution_is_used_and_reported(plugin):
     assert coarse["resolution"] == 40 and fine["resolution"] == 120
     assert fine["surface_faces"] > 4 * coarse["surface_faces"]
     assert fine["cell_size"] == pytest.approx(coarse["cell_size"] / 3)
+
+
+def test_a_capped_automatic_resolution_is_reported_with_its_cause(plugin):
+    """Two small dense spheres 20 apart: the spacing asks for about 8,000 cells along the box;
+    the automatic resolution stops at 1024 and the result says what the spacing asked for (the
+    log's warning quotes the same figures; pymeshlab shows a log only now and then)."""
+    sphere = 0.05 * fibonacci_sphere(2000)
+    points = np.vstack([sphere, sphere + [20, 0, 0]])
+    ms = new_set(points, np.vstack([sphere, sphere]) / 0.05)
+    result = getattr(ms, FILTER)()
+    assert result["resolution"] == 1024
+    assert result["resolution_from_spacing"] == pytest.approx(20.1 / (0.6 * result["sample_spacing"]), rel=0.01)
+    ms.set_current_mesh(0)
+    finer = getattr(ms, FILTER)(resolution=2000)  # finer than the cap, set by hand
+    assert finer["resolution"] == 2000 and finer["resolution_from_spacing"] == result["resolution_from_spacing"]
 
 
 def test_paper_occupancy_is_selectable(plugin):

@@ -23,11 +23,17 @@ struct MemoryBudget
         return pages > 0 && page > 0 ? 0.5 * double(pages) * double(page) : 4e9;
     }
 
-    /// Estimated peak bytes of an extraction over `sodsCells` cells, plus a dense array of
-    /// `denseCorners` values (0 for the SODS-driven extraction).
-    static double ExtractionBytes(double sodsCells, double denseCorners)
+    /// Peak bytes per input sample, held while the surface is extracted: the input and its
+    /// distinct, outlier-free copies, normals, the shared k-d tree, local spacings, the points
+    /// projected onto the zero set and the PU-RBF's octree and local fits.
+    static constexpr double kBytesPerSample = 150;
+
+    /// Estimated peak bytes of a run over `samples` input samples and an extraction over
+    /// `sodsCells` cells, plus a dense array of `denseCorners` values (0 for the SODS-driven
+    /// extraction). The host's own copy of the layer is not counted: it exists before the run.
+    static double PeakBytes(double samples, double sodsCells, double denseCorners)
     {
-        return kBytesPerSodsCell * sodsCells + 8.0 * denseCorners;
+        return kBytesPerSample * samples + kBytesPerSodsCell * sodsCells + 8.0 * denseCorners;
     }
 };
 

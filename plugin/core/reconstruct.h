@@ -209,6 +209,7 @@ public:
         bool hole_search_capped = false;
         int resolution = 0;
         bool resolution_automatic = false;
+        int resolution_from_spacing = 0;  ///< what the spacing asks for (longest side / kCellPerSpacing spacings)
         double cell_size = 0;
         double sample_spacing = 0;
         Index3 lattice_cells = Index3::Zero();
@@ -218,6 +219,7 @@ public:
         size_t crossed_corners = 0;  ///< corners of the SODS and hole cells the surface crosses
         double lattice_corners = 0;  ///< what a full-lattice extraction would have evaluated
         double memory_limit = 0;     ///< the budget used, bytes
+        double memory_estimate = 0;  ///< the estimated peak, bytes (MemoryBudget::PeakBytes)
         bool normals_estimated = false;
         bool normals_flipped = false;
         size_t normals_turned = 0;        ///< estimated normals turned to agree with their neighbours
@@ -291,21 +293,14 @@ private:
         const std::vector<int> scan = ScanOf(p.scan_sizes, input.rows(), kept);
         const Eigen::VectorXd spacing = ScanSpacing(samples, scan, p.threads);
         r.sample_spacing = SampleSpacing::Median(spacing);
-        const std::unique_ptr<ImplicitFunction> fitted =
-            p.implicit == Implicit::Given ? nullptr : MakeImplicit(P, normals, samples, p, cb);
-        const ImplicitFunction& f = fitted ? *fitted : *p.given;
-        if (const auto* rbf = dynamic_cast<const PuRbf*>(fitted.get()))
-            r.rbf_cells = rbf->Cells();
-        r.seconds_implicit = seconds(t);
-
-        t = Clock::now();
         const Eigen::Vector3d lo = P.colwise().minCoeff().transpose(), hi = P.colwise().maxCoeff().transpose();
         const double longest = (hi - lo).maxCoeff();
         r.resolution_automatic = p.resolution == 0;
         r.resolution = p.resolution;
+        r.resolution_from_spacing =
+            int(std::min(1e9, std::round(longest / (kCellPerSpacing * r.sample_spacing))));
         if (r.resolution_automatic)
-            r.resolution = std::clamp(int(std::lround(longest / (kCellPerSpacing * r.sample_spacing))),
-                                      kMinResolution, kMaxAutoResolution);
+            r.resolution = std::clamp(r.resolution_from_spacing, kMinResolution, kMaxAutoResolution);
         // Padding keeps every SODS cell and its corners inside the lattice: the widest disk
         // (capped at the lattice size: an outlier's disk may be clipped), the dilation, one more.
         const double cell = longest / r.resolution;
@@ -317,9 +312,18 @@ private:
         r.lattice_cells = lattice.cells;
         r.lattice_corners = lattice.CornerCount();
         r.memory_limit = p.memory_limit > 0 ? p.memory_limit : MemoryBudget::Default();
-        // Before the SODS: a surface of n samples at spacing s covers about n·s² / cell² cells.
+        // Before the implicit function, the largest per-sample cost: a surface of n samples at
+        // spacing s covers about n·s² / cell² cells.
         const double expectedCells = 2.0 * double(P.rows()) * std::pow(r.sample_spacing / cell, 2);
-        CheckMemory(p.extraction, lattice, expectedCells, r);
+        CheckMemory(p.extraction, lattice, double(input.rows()), expectedCells, r);
+        const std::unique_ptr<ImplicitFunction> fitted =
+            p.implicit == Implicit::Given ? nullptr : MakeImplicit(P, normals, samples, p, cb);
+        const ImplicitFunction& f = fitted ? *fitted : *p.given;
+        if (const auto* rbf = dynamic_cast<const PuRbf*>(fitted.get()))
+            r.rbf_cells = rbf->Cells();
+        r.seconds_implicit = seconds(t);
+
+        t = Clock::now();
         if (cb) cb(36, "Building the spatial occupancy data structure");
         Sods sods = p.occupancy == Occupancy::TangentDisks
                         ? Sods::FromDisks(lattice, OnZeroSet(P, normals, f), normals, p.sample_radius * spacing,
@@ -329,7 +333,7 @@ private:
             sods = sods.Dilated();
         r.sods_cells = sods.Count();
         r.seconds_sods = seconds(t);
-        CheckMemory(p.extraction, lattice, double(r.sods_cells), r);
+        CheckMemory(p.extraction, lattice, double(input.rows()), double(r.sods_cells), r);
 
         t = Clock::now();
         // Extracted straight into `surface`: the hole faces are split off at the end, so a large
@@ -664,23 +668,30 @@ public:
         return N.rows() > 0 && (N.rowwise().squaredNorm().array() > 0).any();
     }
 
-    /// Refuses, before allocating, a run whose estimated peak (from the SODS cells, or from the
-    /// lattice for full-lattice extraction) exceeds r.memory_limit.
-    static void CheckMemory(GatedMarchingCubes::Extraction extraction, const Lattice& lattice, double sodsCells,
-                            const Result& r)
+    /// Refuses, before allocating, a run whose estimated peak (MemoryBudget::PeakBytes: the
+    /// samples, and the SODS cells or, for full-lattice extraction, the lattice) exceeds
+    /// r.memory_limit; records the estimate in r.memory_estimate.
+    static void CheckMemory(GatedMarchingCubes::Extraction extraction, const Lattice& lattice, double samples,
+                            double sodsCells, Result& r)
     {
         const bool dense = extraction != GatedMarchingCubes::Extraction::SodsDriven;
-        const double bytes = MemoryBudget::ExtractionBytes(sodsCells, dense ? lattice.CornerCount() : 0);
+        const double bytes = MemoryBudget::PeakBytes(samples, sodsCells, dense ? lattice.CornerCount() : 0);
+        r.memory_estimate = bytes;
         if (bytes <= r.memory_limit)
             return;
+        const double sampleBytes = MemoryBudget::PeakBytes(samples, 0, 0);
         std::ostringstream msg;
         msg.precision(2);
         msg << std::fixed << "Resolution " << r.resolution << " would need about " << bytes / 1e9
-            << " GB of memory " << (dense ? "(the full lattice has " : "(") << std::setprecision(0)
-            << (dense ? lattice.CornerCount() : sodsCells) << (dense ? " corners)" : " occupied cells)")
-            << std::setprecision(2) << ", over the limit of " << r.memory_limit / 1e9
-            << " GB: lower the resolution (0 = automatic)"
-            << (dense ? ", use the SODS-driven extraction" : "") << " or raise the memory limit.";
+            << " GB of memory (" << std::setprecision(0) << samples << " samples, "
+            << (dense ? lattice.CornerCount() : sodsCells) << (dense ? " lattice corners)" : " occupied cells)")
+            << std::setprecision(2) << ", over the limit of " << r.memory_limit / 1e9 << " GB: ";
+        if (2 * sampleBytes > r.memory_limit)  // the samples' share alone: a coarser lattice does not help
+            msg << "the samples alone need about " << sampleBytes / 1e9
+                << " GB; thin them out (e.g. Poisson-disk sampling) or raise the memory limit.";
+        else
+            msg << "lower the resolution (0 = automatic)" << (dense ? ", use the SODS-driven extraction" : "")
+                << " or raise the memory limit.";
         throw InputError(msg.str());
     }
 

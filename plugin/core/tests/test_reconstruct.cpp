@@ -243,9 +243,31 @@ TEST(Reconstruction, RefusesRunsOverTheMemoryLimit)
         Reconstruction::Compute(P, N, p, m);
         FAIL() << "no error";
     } catch (const InputError& e) {
-        EXPECT_NE(std::string(e.what()).find("full lattice"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("lattice corners"), std::string::npos) << e.what();
         EXPECT_NE(std::string(e.what()).find("SODS-driven"), std::string::npos);
     }
+}
+
+TEST(Reconstruction, RefusesSamplesThatAloneExceedTheMemoryLimit)
+{
+    // 20,000 samples need about 3 MB whatever the lattice: a coarser one would not help.
+    Points P, N;
+    test::SpherePoints(20000, 1.0, P, N);
+    Reconstruction::Param p;
+    p.resolution = 16;
+    p.memory_limit = 0.6 * MemoryBudget::PeakBytes(20000, 0, 0);
+    CoreMesh m;
+    try {
+        Reconstruction::Compute(P, N, p, m);
+        FAIL() << "no error";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("20000 samples"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("the samples alone need"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(m.VN(), 0);
+    p.memory_limit = 0;  // the default: fits, and the estimate is reported
+    const Reconstruction::Result r = Reconstruction::Compute(P, N, p, m);
+    EXPECT_GE(r.memory_estimate, MemoryBudget::PeakBytes(20000, double(r.sods_cells), 0));
 }
 
 
