@@ -2,7 +2,7 @@
 #   make demo   installs what is missing, builds the plugin, reconstructs pymeshlab's bunny
 #   make test   the same setup, then every test (C++ core, Python/pymeshlab, GUI load check,
 #               the core's tests again under AddressSanitizer + UndefinedBehaviorSanitizer)
-#   make fuzz   many more random inputs through the filter than the bounded run in make test
+#   make fuzz   10,000 random inputs through the filter (real meshes damaged, when ../shared/data is there)
 #   make wheel  dist/implicit_boundaries-*.whl, the Python package with the double plugin inside
 #   make install-plugin MESHLAB=<folder of the meshlab binary>   the plugin that fits that MeshLab
 PYTHON ?= python3
@@ -12,7 +12,7 @@ SANITIZE_BUILD ?= build-sanitize
 FLOAT_BUILD    ?= build-float
 DOUBLE_PLUGIN  := python/implicit_boundaries/lib/libfilter_implicit_boundaries.so
 FLOAT_PLUGIN   := $(FLOAT_BUILD)/meshlab-2025.07/libfilter_implicit_boundaries.so
-FUZZ_EXAMPLES  ?= 400
+FUZZ_EXAMPLES  ?= 10000
 
 .PHONY: all deps plugin plugin-float demo wheel install-plugin test test-core test-python test-sanitize fuzz gui gui-double clean
 

@@ -7,7 +7,10 @@ and replays exactly. The filter runs in a persistent child process: a segfault o
 is reported as a failure of that example instead of killing pytest.
 
 The default run is bounded (CI); ``IB_FUZZ_PROFILE=fuzz`` (``make fuzz``) runs many more,
-larger and randomised examples (``IB_FUZZ_EXAMPLES`` sets how many).
+larger and randomised examples (``IB_FUZZ_EXAMPLES`` sets how many): up to 20,000 points,
+resolutions up to 256, and, where the team's data folder is there (``IB_FUZZ_DATA``, default
+``../shared/data`` beside the repository), its real meshes with random damage: holes punched,
+noise, outliers, normals dropped, zeroed or duplicated.
 """
 import multiprocessing
 import os
@@ -29,8 +32,13 @@ SETTINGS = {
     "fuzz": settings(max_examples=int(os.environ.get("IB_FUZZ_EXAMPLES", "400")), deadline=None,
                      suppress_health_check=[HealthCheck.too_slow]),
 }[PROFILE]
-MAX_POINTS = 3000 if PROFILE == "fuzz" else 600
-MAX_RESOLUTION = 200 if PROFILE == "fuzz" else 48
+MAX_POINTS = 20000 if PROFILE == "fuzz" else 600
+MAX_RESOLUTION = 256 if PROFILE == "fuzz" else 48
+DATA = Path(os.environ.get("IB_FUZZ_DATA", Path(__file__).resolve().parent.parent.parent / "shared" / "data"))
+# Real meshes (vertex positions and normals from their faces) for the fuzz profile only: the
+# default run must not depend on files outside the repository.
+MESHES = sorted(str(p.relative_to(DATA)) for p in DATA.glob("**/*") if p.suffix in (".ply", ".off", ".obj")
+                and "bunny_scans" not in p.parts) if PROFILE == "fuzz" and DATA.is_dir() else []
 # A run that takes longer than this is a hang (the largest fuzz example takes a few seconds).
 CHILD_TIMEOUT = 600
 
@@ -165,14 +173,59 @@ def shape_points(kind, n, rng):
     return points, normals
 
 
+_MESH_CACHE = {}
+
+
+def mesh_samples(name):
+    """A real mesh's vertices and unit normals from its faces (zero where a vertex has none)."""
+    if name not in _MESH_CACHE:
+        import pymeshlab
+        ms = pymeshlab.MeshSet()
+        ms.load_new_mesh(str(DATA / name))
+        if ms.current_mesh().face_number() > 0:
+            ms.compute_normal_per_vertex()
+        m = ms.current_mesh()
+        _MESH_CACHE[name] = (m.vertex_matrix().copy(), m.vertex_normal_matrix().copy())
+    return _MESH_CACHE[name]
+
+
+def damaged_mesh(recipe, rng):
+    """Up to n samples of a real mesh, with holes punched (balls of 2-10% of the diagonal
+    removed), Gaussian noise and uniform outliers in its box, as the recipe says."""
+    points, normals = mesh_samples(recipe["mesh"])
+    if len(points) > recipe["n"]:
+        keep = rng.choice(len(points), recipe["n"], replace=False)
+        points, normals = points[keep], normals[keep]
+    if len(points) == 0:
+        return points, normals
+    diagonal = np.linalg.norm(np.ptp(points, axis=0))
+    keep = np.ones(len(points), bool)
+    for _ in range(recipe["holes"]):
+        centre, radius = points[rng.integers(len(points))], diagonal * rng.uniform(0.02, 0.1)
+        keep &= np.linalg.norm(points - centre, axis=1) > radius
+    points, normals = points[keep], normals[keep]
+    if len(points) == 0:
+        return points, normals
+    points = points + rng.normal(scale=recipe["noise"] * diagonal, size=points.shape)
+    strays = int(recipe["outliers"] * len(points))
+    lo, hi = points.min(axis=0), points.max(axis=0)
+    points = np.vstack([points, lo + (hi - lo) * rng.random((strays, 3))])
+    normals = np.vstack([normals, unit(rng.normal(size=(strays, 3)) + 1e-12)])
+    return points, normals
+
+
 def build_cloud(recipe):
     """Points (n×3) and normals (n×3 or None) from a recipe drawn by `clouds`."""
     rng = np.random.default_rng(recipe["seed"])
     n = recipe["n"]
-    counts = np.bincount(rng.integers(0, len(recipe["shapes"]), n), minlength=len(recipe["shapes"]))
-    parts = [shape_points(kind, int(c), rng) for kind, c in zip(recipe["shapes"], counts)]
-    points = np.concatenate([p for p, _ in parts] + [np.zeros((0, 3))])
-    normals = np.concatenate([q for _, q in parts] + [np.zeros((0, 3))])
+    if recipe.get("mesh"):
+        points, normals = damaged_mesh(recipe, rng)
+        n = len(points)
+    else:
+        counts = np.bincount(rng.integers(0, len(recipe["shapes"]), n), minlength=len(recipe["shapes"]))
+        parts = [shape_points(kind, int(c), rng) for kind, c in zip(recipe["shapes"], counts)]
+        points = np.concatenate([p for p, _ in parts] + [np.zeros((0, 3))])
+        normals = np.concatenate([q for _, q in parts] + [np.zeros((0, 3))])
     if recipe["duplicates"] and n:
         picked = rng.integers(0, n, int(recipe["duplicates"] * n))
         points, normals = np.concatenate([points, points[picked]]), np.concatenate([normals, normals[picked]])
@@ -193,7 +246,13 @@ def build_cloud(recipe):
 
 @st.composite
 def clouds(draw, max_points=MAX_POINTS):
+    mesh = draw(st.sampled_from([None] + MESHES)) if MESHES else None
+    damage = {}
+    if mesh:
+        damage = {"mesh": mesh, "holes": draw(st.integers(0, 4)), "noise": draw(st.sampled_from([0, 0.001, 0.005])),
+                  "outliers": draw(st.sampled_from([0, 0.001, 0.01]))}
     return {
+        **damage,
         "n": draw(st.one_of(st.integers(0, 30), st.integers(0, max_points))),
         "shapes": draw(st.lists(st.sampled_from(SHAPES), min_size=1, max_size=3)),
         "scale": draw(st.sampled_from([1.0, 1e-6, 1e6])),
