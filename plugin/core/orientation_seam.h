@@ -8,7 +8,11 @@
 /// seam is cut instead: surface faces near a seam point are moved into the holes, leaving one
 /// clean boundary across the surface.
 /// Opposite normals across a thin part (the two sides of a plate) are not a seam: there each
-/// sample lies off the other's tangent plane by the part's thickness.
+/// sample lies off the other's tangent plane by the part's thickness. Nor along a sharp fold
+/// (a thin part's rim, a narrow V-groove's crease), where the two sides meet: the pairs right
+/// at the fold lie in each other's tangent planes, but the sample's other opposite-facing
+/// neighbours, a little way along the other side, lie off its tangent plane; on a flipped
+/// sheet every opposite-facing neighbour lies in it.
 
 #include "mesh.h"
 #include "parallel.h"
@@ -31,7 +35,7 @@ public:
     static constexpr double kInPlane = 0.25;
 
     /// Seam points: the midpoints of the neighbouring pairs (i, j), i < j, of samples whose unit
-    /// normals N (n×3) disagree while each lies in the other's tangent plane. spacing: per
+    /// normals N (n×3) disagree while each lies in the other's tangent plane, neither at a fold. spacing: per
     /// sample, its local spacing. scan: per sample, its scan when several are merged; pairs from
     /// different scans are skipped: a registration error cannot flip a normal, so a flip there
     /// is one scan's wrong normal at a grazing border, which the implicit function outvotes
@@ -42,6 +46,20 @@ public:
     {
         const Points& P = samples.P();
         const int k = std::min<int>(8, int(P.rows()) - 1);
+        auto comparable = [&](Eigen::Index a, Eigen::Index b) { return scan.empty() || scan[size_t(a)] == scan[size_t(b)]; };
+        // Per sample, whether it sits at a fold: an opposite-facing neighbour lies off its tangent plane.
+        std::vector<char> fold(size_t(P.rows()), 0);
+        ParallelFor(size_t(P.rows()), threads, [&](size_t begin, size_t end, int) {
+            SampleIndex::Queue queue;
+            for (size_t i = begin; i < end; ++i) {
+                const Eigen::Index a = Eigen::Index(i);
+                samples.Nearest(P.row(a).transpose(), k + 1, queue);
+                for (int q = 0; q < queue.getNofElements() && !fold[i]; ++q) {
+                    const Eigen::Index b = queue.getIndex(q);
+                    fold[i] = comparable(a, b) && Opposite(P, N, a, b, spacing[a]) && !InPlane(P, N, a, b, spacing[a]);
+                }
+            }
+        }, 256);
         // Per sample, its seam partners of higher index: the order of the points does not
         // depend on the thread count.
         std::vector<std::vector<Eigen::Index>> partners(size_t(P.rows()));
@@ -49,10 +67,13 @@ public:
             SampleIndex::Queue queue;
             for (size_t i = begin; i < end; ++i) {
                 const Eigen::Index a = Eigen::Index(i);
+                if (fold[i])
+                    continue;
                 samples.Nearest(P.row(a).transpose(), k + 1, queue);
                 for (int q = 0; q < queue.getNofElements(); ++q) {
                     const Eigen::Index b = queue.getIndex(q);
-                    if (b > a && (scan.empty() || scan[size_t(a)] == scan[size_t(b)]) && Disagree(P, N, a, b, spacing[a]))
+                    if (b > a && !fold[size_t(b)] && comparable(a, b) && Opposite(P, N, a, b, spacing[a]) &&
+                        InPlane(P, N, a, b, spacing[a]))
                         partners[i].push_back(b);
                 }
             }
@@ -96,12 +117,17 @@ public:
     }
 
 private:
-    static bool Disagree(const Points& P, const Points& N, Eigen::Index a, Eigen::Index b, double spacing)
+    /// Neighbours (within kNeighbourhood spacings) whose normals disagree.
+    static bool Opposite(const Points& P, const Points& N, Eigen::Index a, Eigen::Index b, double spacing)
     {
-        const Eigen::Vector3d d = (P.row(b) - P.row(a)).transpose();
-        const Eigen::Vector3d na = N.row(a).transpose(), nb = N.row(b).transpose();
-        return na.dot(nb) < kOpposite && d.norm() <= kNeighbourhood * spacing &&
-               std::abs(d.dot(na)) < kInPlane * spacing && std::abs(d.dot(nb)) < kInPlane * spacing;
+        return N.row(a).dot(N.row(b)) < kOpposite && (P.row(b) - P.row(a)).norm() <= kNeighbourhood * spacing;
+    }
+
+    /// Each lies in the other's tangent plane.
+    static bool InPlane(const Points& P, const Points& N, Eigen::Index a, Eigen::Index b, double spacing)
+    {
+        const Eigen::RowVector3d d = P.row(b) - P.row(a);
+        return std::abs(d.dot(N.row(a))) < kInPlane * spacing && std::abs(d.dot(N.row(b))) < kInPlane * spacing;
     }
 };
 

@@ -686,7 +686,7 @@ public:
             << " GB of memory (" << std::setprecision(0) << samples << " samples, "
             << (dense ? lattice.CornerCount() : sodsCells) << (dense ? " lattice corners)" : " occupied cells)")
             << std::setprecision(2) << ", over the limit of " << r.memory_limit / 1e9 << " GB: ";
-        if (2 * sampleBytes > r.memory_limit)  // the samples' share alone: a coarser lattice does not help
+        if (sampleBytes > r.memory_limit)  // no lattice, however coarse, would fit
             msg << "the samples alone need about " << sampleBytes / 1e9
                 << " GB; thin them out (e.g. Poisson-disk sampling) or raise the memory limit.";
         else

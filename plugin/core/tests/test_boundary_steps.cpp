@@ -112,6 +112,43 @@ TEST(BoundarySteps, FlippedNormalsAreCutAlongTheFlip)
     EXPECT_EQ(OrientationSeam::Find(plateSamples, sides, SampleSpacing::Local(plateSamples)).rows(), 0);
 }
 
+TEST(BoundarySteps, SharpFoldsAreNoSeam)
+{
+    // Opposite-facing samples meet at a sharp fold with no flip: the crease of a 30-degree
+    // V-groove (normals into the groove) and the rim of a plate 1.5 spacings thick (outward).
+    // Right at the fold, pairs lie in each other's tangent planes; their neighbours along the
+    // other side do not.
+    const double s = 0.02, half = 15 * EIGEN_PI / 180;
+    std::vector<Eigen::RowVector3d> groove, grooveNormals, plate, plateNormals;
+    for (double u = -1 + s / 2; u < 1; u += s)
+        for (double y = 0; y <= 1; y += s) {
+            const double side = u > 0 ? 1 : -1;
+            groove.emplace_back(std::abs(u) * std::sin(half) * side, y, std::abs(u) * std::cos(half));
+            grooveNormals.emplace_back(-side * std::cos(half), 0, std::sin(half));
+        }
+    const double c = 0.75 * s;  // half the thickness: the plate z = +-c sqrt(1 - x^2 - y^2)
+    for (double x = -1; x <= 1; x += s)
+        for (double y = -1; y <= 1; y += s) {
+            const double r2 = x * x + y * y;
+            if (r2 >= 1)
+                continue;
+            for (double side : {1.0, -1.0}) {
+                const Eigen::RowVector3d p(x, y, side * c * std::sqrt(1 - r2));
+                plate.push_back(p);
+                plateNormals.push_back(Eigen::RowVector3d(p[0], p[1], p[2] / (c * c)).normalized());
+            }
+        }
+    for (auto [points, normals] : {std::pair{&groove, &grooveNormals}, std::pair{&plate, &plateNormals}}) {
+        Points P(Eigen::Index(points->size()), 3), N(P.rows(), 3);
+        for (Eigen::Index i = 0; i < P.rows(); ++i) {
+            P.row(i) = (*points)[size_t(i)];
+            N.row(i) = (*normals)[size_t(i)];
+        }
+        const SampleIndex samples(P);
+        EXPECT_EQ(OrientationSeam::Find(samples, N, SampleSpacing::Local(samples)).rows(), 0) << P.rows();
+    }
+}
+
 /// The plane z = 0 (signed distance z) and, when `balloon`, a tube of radius 0.04 rising from it
 /// at (0.5, 0.5) into a ball of radius 0.15 at height 0.35: an implicit surface that closes a
 /// gap in a flat scan by a detour far from every sample.

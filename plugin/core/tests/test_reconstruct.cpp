@@ -238,7 +238,7 @@ TEST(Reconstruction, RefusesRunsOverTheMemoryLimit)
     EXPECT_NO_THROW(Reconstruction::Compute(P, N, p, m));
     p.extraction = GatedMarchingCubes::Extraction::FullLatticeGated;
     p.resolution = 200;
-    p.memory_limit = 30e6;
+    p.memory_limit = 40e6;
     try {
         Reconstruction::Compute(P, N, p, m);
         FAIL() << "no error";
@@ -250,7 +250,7 @@ TEST(Reconstruction, RefusesRunsOverTheMemoryLimit)
 
 TEST(Reconstruction, RefusesSamplesThatAloneExceedTheMemoryLimit)
 {
-    // 20,000 samples need about 3 MB whatever the lattice: a coarser one would not help.
+    // Whatever the lattice, 20,000 samples need more than this limit: a coarser one would not help.
     Points P, N;
     test::SpherePoints(20000, 1.0, P, N);
     Reconstruction::Param p;
