@@ -4,6 +4,8 @@ layer with its alignment matrix, as MeshLab's Align tool leaves them), measured 
 ground truth (issue: the MeshLab scanning workflow).
 
     python bench/merged.py [ALIGNMENT] [--truth MESH] [--params k=v ...]
+    python bench/merged.py [ALIGNMENT] --surface MESH   # only measure a surface made elsewhere
+                                                         # (bench/merged_gui.sh: in the MeshLab GUI)
 
 Defaults: the 9 Stanford bunny range scans placed by their bun.conf, and the zippered bunny
 (bun_zipper.ply) as the truth, from ../shared/data. Columns: boundary loops (the truth's: 5,
@@ -74,6 +76,7 @@ def main(argv=None):
     parser.add_argument("alignment", nargs="?", default=str(DEFAULT_DATA / "bunny_scans" / "bun.conf"))
     parser.add_argument("--truth", default=str(DEFAULT_DATA / "bun_zipper.ply"))
     parser.add_argument("--params", nargs="*", default=[], help="our filter's parameters, name=value")
+    parser.add_argument("--surface", help="measure this mesh (made from the same scans elsewhere) instead of running")
     args = parser.parse_args(argv)
     implicit_boundaries.load()
     alignment = Path(args.alignment)
@@ -85,9 +88,14 @@ def main(argv=None):
 
     ours, seconds = run_ours(alignment, parse_params(args.params))
     depth = poisson_depth(int(ours.info["resolution"]))
-    runs = [("ours (merge visible layers)", ours, seconds),
-            (f"screened Poisson, depth {depth} (merge visible layers)", *run_poisson(alignment, depth, 0)),
-            ("screened Poisson + density trim 5%", *run_poisson(alignment, depth, 0.05))]
+    if args.surface:
+        given = pymeshlab.MeshSet()
+        given.load_new_mesh(args.surface)
+        runs = [(f"{Path(args.surface).name} (made elsewhere; time: ours here)", Surface(*_copy(given.current_mesh())), seconds)]
+    else:
+        runs = [("ours (merge visible layers)", ours, seconds),
+                (f"screened Poisson, depth {depth} (merge visible layers)", *run_poisson(alignment, depth, 0)),
+                ("screened Poisson + density trim 5%", *run_poisson(alignment, depth, 0.05))]
     tolerance = 2.5 * ours.info["sample_spacing"] + 2 * ours.info["cell_size"]
     diagonal = float(np.linalg.norm(np.ptp(truth[0], axis=0)))
     print(f"{alignment.name}: {len(cloud.points)} samples in {len(read_alignment(alignment))} scans; truth {Path(args.truth).name}: "
