@@ -13,14 +13,16 @@ plugin=${3:-$root/build-float/meshlab-2025.07/libfilter_implicit_boundaries.so}
 . "$root/tests/gui/common.sh"
 gui_init "$distrib" "$plugin" "$root/out/merged-gui"
 
-python3 - "$conf" "$work/scans.aln" <<'PY'
-import sys
+# MeshLab reads an .aln's file names relative to its folder: the scans are linked beside it.
+python3 - "$conf" "$work" <<'PY'
+import os, sys
 from implicit_boundaries.alignment import read_alignment
 scans = read_alignment(sys.argv[1])
-with open(sys.argv[2], "w") as f:
+with open(os.path.join(sys.argv[2], "scans.aln"), "w") as f:
     f.write(f"{len(scans)}\n")
     for path, m in scans:
-        f.write(f"{path.resolve()}\n#\n" + "".join(" ".join("%.17g" % v for v in row) + "\n" for row in m))
+        os.symlink(path.resolve(), os.path.join(sys.argv[2], path.name))
+        f.write(f"{path.name}\n#\n" + "".join(" ".join("%.17g" % v for v in row) + "\n" for row in m))
     f.write("0\n")
 PY
 
