@@ -7,6 +7,7 @@ import pytest
 from scipy.spatial import cKDTree
 
 import implicit_boundaries
+import shapes
 from shapes import fibonacci_sphere, wavy_cap
 
 
@@ -71,3 +72,24 @@ def test_random_samples_of_an_open_surface_have_one_loop(plugin, cells_per_spaci
     u = rec.vertices / np.linalg.norm(rec.vertices, axis=1, keepdims=True)
     radius = 1 + 0.03 * np.sin(8 * u[:, 0]) * np.sin(8 * u[:, 1])
     assert np.abs(np.linalg.norm(rec.vertices, axis=1) - radius).max() < 0.5 * rec.info["sample_spacing"]
+
+
+def test_a_thin_plate_three_spacings_thick_stays_closed():
+    """A closed plate whose sides are 3 sample spacings apart (an ear, a fin), exact normals: no
+    loop. Its rim was cut as an orientation seam (opposite normals in each other's tangent
+    planes) and gated out (the surface turns there between the sides' flat disks): 8 loops."""
+    points, normals = shapes.thin_plate(3)
+    rec = implicit_boundaries.reconstruct(points, normals)
+    assert len(rec.loops) == 0 and rec.info["seam_points"] == 0
+    _, nearest = cKDTree(points).query(rec.vertices)
+    assert nearest.size and np.max(np.linalg.norm(rec.vertices - points[nearest], axis=1)) < 2 * rec.info["sample_spacing"]
+
+
+def test_a_narrow_v_groove_keeps_only_its_rim():
+    """An open sheet folded into a 30-degree V-groove (a sharp concave crease), exact normals:
+    one loop, the rim; none along the crease (6 loops when the crease was taken for a seam)."""
+    points, normals = shapes.v_groove(30)
+    rec = implicit_boundaries.reconstruct(points, normals)
+    assert len(rec.loops) == 1
+    rim = rec.vertices[rec.loops[0]]
+    assert np.min(np.maximum(np.abs(rim[:, 1]), np.linalg.norm(rim[:, [0, 2]], axis=1))) > 0.9  # all at the sheet's edge

@@ -34,32 +34,46 @@ public:
     /// (plates thinner than that are below what the samples resolve).
     static constexpr double kInPlane = 0.25;
 
-    /// Seam points: the midpoints of the neighbouring pairs (i, j), i < j, of samples whose unit
-    /// normals N (n×3) disagree while each lies in the other's tangent plane, neither at a fold. spacing: per
-    /// sample, its local spacing. scan: per sample, its scan when several are merged; pairs from
-    /// different scans are skipped: a registration error cannot flip a normal, so a flip there
-    /// is one scan's wrong normal at a grazing border, which the implicit function outvotes
-    /// (cutting there opened 11 of the 31 loops of the 9 merged Stanford bunny scans).
-    /// Returns m×3 points, m = 0 for consistently oriented samples.
-    static Points Find(const SampleIndex& samples, const Points& N, const Eigen::VectorXd& spacing, int threads = 0,
-                       const std::vector<int>& scan = {})
+    /// Per sample, how far its opposite-facing neighbours (normals over 120 degrees apart,
+    /// within kNeighbourhood spacings, of the same scan) lie off its tangent plane at most: 0
+    /// on a sheet with nothing facing it; about the distance to the other side at a thin part's
+    /// rim or a narrow groove's crease. A sample is at a fold when this is at least kInPlane
+    /// spacings. spacing and scan as in Find.
+    static Eigen::VectorXd FoldWidths(const SampleIndex& samples, const Points& N, const Eigen::VectorXd& spacing,
+                                      int threads = 0, const std::vector<int>& scan = {})
     {
         const Points& P = samples.P();
         const int k = std::min<int>(8, int(P.rows()) - 1);
-        auto comparable = [&](Eigen::Index a, Eigen::Index b) { return scan.empty() || scan[size_t(a)] == scan[size_t(b)]; };
-        // Per sample, whether it sits at a fold: an opposite-facing neighbour lies off its tangent plane.
-        std::vector<char> fold(size_t(P.rows()), 0);
+        Eigen::VectorXd width = Eigen::VectorXd::Zero(P.rows());
         ParallelFor(size_t(P.rows()), threads, [&](size_t begin, size_t end, int) {
             SampleIndex::Queue queue;
             for (size_t i = begin; i < end; ++i) {
                 const Eigen::Index a = Eigen::Index(i);
                 samples.Nearest(P.row(a).transpose(), k + 1, queue);
-                for (int q = 0; q < queue.getNofElements() && !fold[i]; ++q) {
+                for (int q = 0; q < queue.getNofElements(); ++q) {
                     const Eigen::Index b = queue.getIndex(q);
-                    fold[i] = comparable(a, b) && Opposite(P, N, a, b, spacing[a]) && !InPlane(P, N, a, b, spacing[a]);
+                    if ((scan.empty() || scan[size_t(a)] == scan[size_t(b)]) && Opposite(P, N, a, b, spacing[a]))
+                        width[a] = std::max(width[a], std::abs((P.row(b) - P.row(a)).dot(N.row(a))));
                 }
             }
         }, 256);
+        return width;
+    }
+
+    /// Seam points: the midpoints of the neighbouring pairs (i, j), i < j, of samples whose unit
+    /// normals N (n×3) disagree while each lies in the other's tangent plane, neither at a fold
+    /// (foldWidth: FoldWidths of the same samples). spacing: per sample, its local spacing.
+    /// scan: per sample, its scan when several are merged; pairs from different scans are
+    /// skipped: a registration error cannot flip a normal, so a flip there is one scan's wrong
+    /// normal at a grazing border, which the implicit function outvotes (cutting there opened
+    /// 11 of the 31 loops of the 9 merged Stanford bunny scans). Returns m×3 points, m = 0 for
+    /// consistently oriented samples.
+    static Points Find(const SampleIndex& samples, const Points& N, const Eigen::VectorXd& spacing,
+                       const Eigen::VectorXd& foldWidth, int threads = 0, const std::vector<int>& scan = {})
+    {
+        const Points& P = samples.P();
+        const int k = std::min<int>(8, int(P.rows()) - 1);
+        auto fold = [&](Eigen::Index a) { return foldWidth[a] >= kInPlane * spacing[a]; };
         // Per sample, its seam partners of higher index: the order of the points does not
         // depend on the thread count.
         std::vector<std::vector<Eigen::Index>> partners(size_t(P.rows()));
@@ -67,13 +81,13 @@ public:
             SampleIndex::Queue queue;
             for (size_t i = begin; i < end; ++i) {
                 const Eigen::Index a = Eigen::Index(i);
-                if (fold[i])
+                if (fold(a))
                     continue;
                 samples.Nearest(P.row(a).transpose(), k + 1, queue);
                 for (int q = 0; q < queue.getNofElements(); ++q) {
                     const Eigen::Index b = queue.getIndex(q);
-                    if (b > a && !fold[size_t(b)] && comparable(a, b) && Opposite(P, N, a, b, spacing[a]) &&
-                        InPlane(P, N, a, b, spacing[a]))
+                    if (b > a && !fold(b) && (scan.empty() || scan[size_t(a)] == scan[size_t(b)]) &&
+                        Opposite(P, N, a, b, spacing[a]) && InPlane(P, N, a, b, spacing[a]))
                         partners[i].push_back(b);
                 }
             }

@@ -325,9 +325,12 @@ private:
 
         t = Clock::now();
         if (cb) cb(36, "Building the spatial occupancy data structure");
+        // At a thin part's rim the surface turns between the two sides' flat disks: there they
+        // reach half way to the other side.
+        const Eigen::VectorXd foldWidth = OrientationSeam::FoldWidths(samples, normals, spacing, p.threads, scan);
         Sods sods = p.occupancy == Occupancy::TangentDisks
                         ? Sods::FromDisks(lattice, OnZeroSet(P, normals, f), normals, p.sample_radius * spacing,
-                                          kDiskSlack * lattice.cell_size, p.threads)
+                                          kDiskSlack * lattice.cell_size, p.threads, 0.5 * foldWidth)
                         : Sods::FromSamples(lattice, P);
         for (int i = 0; i < p.sods_dilation; ++i)
             sods = sods.Dilated();
@@ -352,7 +355,7 @@ private:
 
         t = Clock::now();
         if (cb) cb(97, "Tracing boundary loops, filling small holes");
-        const Points seam = OrientationSeam::Find(samples, normals, spacing, p.threads, scan);
+        const Points seam = OrientationSeam::Find(samples, normals, spacing, foldWidth, p.threads, scan);
         r.seam_points = size_t(seam.rows());
         const std::vector<char> inSurface =
             Boundaries(surface, mc, samples, spacing, seam, f, lattice.cell_size, p, r);

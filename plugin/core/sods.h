@@ -33,10 +33,12 @@ public:
 
     /// Occupancy of the cells that the samples' tangent disks pass through: sample i with unit
     /// normal N.row(i) covers the disk of radius radius[i] around it in its tangent plane,
-    /// thickened by `slack` (world units) on each side along the normal. With radii from the
-    /// local sample spacing, sparse regions stay covered while gaps wider than two radii stay open.
-    static Sods FromDisks(const Lattice& lattice, const Points& P, const Points& N,
-                          const Eigen::VectorXd& radius, double slack, int threads = 0)
+    /// thickened by `slack` (world units) on each side along the normal, plus thickness[i] when
+    /// given (empty: none; e.g. half the distance to the other side at a thin part's rim, where
+    /// the surface turns between two sheets of flat disks). With radii from the local sample
+    /// spacing, sparse regions stay covered while gaps wider than two radii stay open.
+    static Sods FromDisks(const Lattice& lattice, const Points& P, const Points& N, const Eigen::VectorXd& radius,
+                          double slack, int threads = 0, const Eigen::VectorXd& thickness = Eigen::VectorXd())
     {
         // One occupancy per block of samples, OR-ed together: the result does not depend on
         // the thread count.
@@ -47,7 +49,8 @@ public:
         ParallelFor(size_t(blocks), blocks, [&](size_t begin, size_t end, int) {
             for (size_t b = begin; b < end; ++b)
                 for (Eigen::Index i = Eigen::Index(b) * per; i < std::min(P.rows(), Eigen::Index(b + 1) * per); ++i)
-                    parts[b].InsertDisk(lattice, P.row(i).transpose(), N.row(i).transpose(), radius[i], slack);
+                    parts[b].InsertDisk(lattice, P.row(i).transpose(), N.row(i).transpose(), radius[i],
+                                        slack + (thickness.size() ? thickness[i] : 0.0));
         }, 1);
         for (size_t b = 1; b < parts.size(); ++b)
             parts[0].Merge(parts[b]);

@@ -75,6 +75,13 @@ TEST(BoundarySteps, FlatScanIsTrimmedToItsBorderAndSmoothed)
     EXPECT_TRUE(t.oriented);
 }
 
+/// OrientationSeam::Find with the samples' own spacings and fold widths.
+Points Seams(const SampleIndex& samples, const Points& N)
+{
+    const Eigen::VectorXd spacing = SampleSpacing::Local(samples);
+    return OrientationSeam::Find(samples, N, spacing, OrientationSeam::FoldWidths(samples, N, spacing));
+}
+
 TEST(BoundarySteps, FlippedNormalsAreCutAlongTheFlip)
 {
     // The flat scan with the normals of its half x > 0.5 turned down: the seam is the line
@@ -85,7 +92,7 @@ TEST(BoundarySteps, FlippedNormalsAreCutAlongTheFlip)
         if (P(i, 0) > 0.5)
             N(i, 2) = -1;
     const SampleIndex samples(P);
-    const Points seam = OrientationSeam::Find(samples, N, SampleSpacing::Local(samples));
+    const Points seam = Seams(samples, N);
     ASSERT_GT(seam.rows(), 40);  // pairs across the line, all along it
     EXPECT_LT((seam.col(0).array() - 0.5).abs().maxCoeff(), 0.02);
     EXPECT_LT(seam.col(1).minCoeff(), 0.05);
@@ -103,13 +110,13 @@ TEST(BoundarySteps, FlippedNormalsAreCutAlongTheFlip)
 
     // Upside down but consistent, or the two sides of a thin plate: no seam.
     N.col(2).setConstant(-1);
-    EXPECT_EQ(OrientationSeam::Find(samples, N, SampleSpacing::Local(samples)).rows(), 0);
+    EXPECT_EQ(Seams(samples, N).rows(), 0);
     Points plate(2 * P.rows(), 3), sides(2 * P.rows(), 3);
     plate << P, P.rowwise() + Eigen::RowVector3d(0.01, 0, -0.01);
     sides << Points::Zero(P.rows(), 3).rowwise() + Eigen::RowVector3d(0, 0, 1),
         Points::Zero(P.rows(), 3).rowwise() + Eigen::RowVector3d(0, 0, -1);
     const SampleIndex plateSamples(plate);
-    EXPECT_EQ(OrientationSeam::Find(plateSamples, sides, SampleSpacing::Local(plateSamples)).rows(), 0);
+    EXPECT_EQ(Seams(plateSamples, sides).rows(), 0);
 }
 
 TEST(BoundarySteps, SharpFoldsAreNoSeam)
@@ -145,7 +152,7 @@ TEST(BoundarySteps, SharpFoldsAreNoSeam)
             N.row(i) = (*normals)[size_t(i)];
         }
         const SampleIndex samples(P);
-        EXPECT_EQ(OrientationSeam::Find(samples, N, SampleSpacing::Local(samples)).rows(), 0) << P.rows();
+        EXPECT_EQ(Seams(samples, N).rows(), 0) << P.rows();
     }
 }
 
