@@ -71,6 +71,7 @@ fuzz: plugin
 # Filters menu on one scan (its surface exported and compared with pymeshlab's, made with the
 # double plugin: same loops, within 1e-4 of the diagonal), then on two aligned scans merged. gui-double: the same with MeshLab 2025.07d and the double plugin (pymeshlab's).
 gui: plugin-float
+	.ci/install-plugin "$$(.ci/meshlab-gui float)" $(DOUBLE_PLUGIN) $(FLOAT_PLUGIN) | grep "installed the float plugin"
 	tests/gui/load_plugin_from_dialog_in_meshlab.sh "$$(.ci/meshlab-gui float)" $(FLOAT_PLUGIN) out/gui-load-plugin
 	tests/gui/apply_filter_in_meshlab.sh "$$(.ci/meshlab-gui float)" $(FLOAT_PLUGIN) out/gui
 	$(PYTHON) tests/gui/same_surface.py out/gui/result.ply
@@ -80,6 +81,7 @@ gui: plugin-float
 
 gui-double: plugin
 	.ci/install-deps gui
+	.ci/install-plugin "$$(.ci/meshlab-gui double)" $(DOUBLE_PLUGIN) $(FLOAT_PLUGIN) | grep "installed the double plugin"
 	tests/gui/apply_filter_in_meshlab.sh "$$(.ci/meshlab-gui double)" $(DOUBLE_PLUGIN) out/gui-double
 	$(PYTHON) tests/gui/same_surface.py out/gui-double/result.ply
 	tests/gui/merge_layers_in_meshlab.sh "$$(.ci/meshlab-gui double)" $(DOUBLE_PLUGIN) out/gui-double-merge
