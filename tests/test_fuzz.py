@@ -362,7 +362,11 @@ def test_random_clouds_and_parameters(worker, recipe, params):
     answer = run_recipe(worker, recipe, params)
     # --hypothesis-show-statistics: how often each outcome came up
     message = answer.get("message", "").split("Details: ")[-1].replace("Implicit reconstruction with boundaries: ", "")
-    event(answer["status"] + (": " + message[:40] if answer["status"] == "refused" else ""))
+    outcome = answer["status"] + (": " + message[:40] if answer["status"] == "refused" else "")
+    event(outcome)
+    if os.environ.get("IB_FUZZ_LOG"):  # a line per example checked, for long runs
+        with open(os.environ["IB_FUZZ_LOG"], "a") as log:
+            log.write(f"{recipe.get('mesh') or '+'.join(recipe['shapes'])} n={recipe['n']}: {outcome}\n")
 
 
 # ---------------------------------------------------------------------------------------------
