@@ -182,11 +182,38 @@ def test_a_capped_automatic_resolution_is_reported_with_its_cause(plugin):
     assert finer["resolution"] == 2000 and finer["resolution_from_spacing"] == result["resolution_from_spacing"]
 
 
+def paper_sods_cells(points, resolution, dilation):
+    """The paper's SODS counted here: the lattice cells holding a sample (the filter's lattice:
+    `resolution` cells along the longest side of the samples' box, centred in `dilation` + 1
+    cells of padding), grown by `dilation` rings of the 26-neighbourhood."""
+    lo, hi = points.min(axis=0), points.max(axis=0)
+    cell = (hi - lo).max() / resolution
+    cells = np.maximum(1, np.ceil((hi - lo) / cell)).astype(int) + 2 * (dilation + 1)
+    origin = lo - 0.5 * (cells * cell - (hi - lo))
+    occupied = np.unique(np.floor((points - origin) / cell).astype(np.int64), axis=0)
+    ring = np.array(np.meshgrid(*[range(-dilation, dilation + 1)] * 3)).reshape(3, -1).T
+    return len(np.unique((occupied[:, None, :] + ring[None]).reshape(-1, 3), axis=0)), cell
+
+
 def test_paper_occupancy_is_selectable(plugin):
+    """The paper's SODS (cells holding samples, dilated) is what the filter uses when asked:
+    its cell count is the one counted here, unlike the tangent disks' (the default); without
+    the dilation it leaves the closed bunny full of holes, with one ring it closes it."""
     points, normals, _ = point_cloud(SAMPLES / "bunny.obj")
-    ms = new_set(points, normals)
-    result = getattr(ms, FILTER)(sods_occupancy="Sample cells (paper)", sods_dilation=1, resolution=100)
-    assert result["boundary_loops"] == 0
+    runs = {}
+    for occupancy, dilation in [("Tangent disks", 0), ("Sample cells (paper)", 0), ("Sample cells (paper)", 1)]:
+        ms = new_set(points, normals)
+        try:
+            runs[occupancy, dilation] = getattr(ms, FILTER)(sods_occupancy=occupancy, sods_dilation=dilation, resolution=100)
+        except pymeshlab.PyMeshLabException as e:
+            raise AssertionError((occupancy, dilation, str(e)))
+    for dilation in (0, 1):
+        expected, cell = paper_sods_cells(points, 100, dilation)
+        assert runs["Sample cells (paper)", dilation]["cell_size"] == pytest.approx(cell)
+        assert runs["Sample cells (paper)", dilation]["sods_cells"] == expected
+    assert runs["Tangent disks", 0]["sods_cells"] != runs["Sample cells (paper)", 1]["sods_cells"]
+    assert runs["Sample cells (paper)", 0]["boundary_loops"] > 100
+    assert runs["Sample cells (paper)", 1]["boundary_loops"] == 0 and runs["Tangent disks", 0]["boundary_loops"] == 0
 
 
 def test_empty_layer_raises_a_clear_error(plugin, tmp_path):
