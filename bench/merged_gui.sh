@@ -30,10 +30,7 @@ gui_start "$work/scans.aln"
 sleep 10  # nine range scans to load
 gui_check_loaded
 gui_open_filter_dialog
-# The ninth Tab from Apply reaches "Merge visible layers" (tests/gui/merge_layers_in_meshlab.sh).
-xdotool windowfocus --sync "$dialog"; sleep 0.5
-for _ in $(seq 9); do xdotool key Tab; sleep 0.2; done
-xdotool key space; sleep 1
+gui_tick_merge_visible_layers
 gui_apply_and_close
 grep -o "Merged [0-9]* visible layers: [0-9]* samples" "$work/meshlab.log" ||
   { echo "FAIL: the layers were not merged (MeshLab's log: $out/meshlab.log)"; exit 1; }

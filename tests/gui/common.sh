@@ -84,6 +84,20 @@ gui_open_filter_dialog() {
   eval "$(xdotool getwindowgeometry --shell "$dialog")"
 }
 
+# gui_tick_merge_visible_layers: ticks the open dialog's "Merge visible layers" box; screenshot
+# merge_ticked.png. MeshLab gives the dialog's Apply button the keyboard focus. The focus chain
+# then runs through the parameters' scroll area and the "Copy PyMeshLab call" button (both made
+# before the parameter widgets) to the parameters in order: Resolution, Implicit function,
+# Implicit mesh layer, SODS occupancy, Min boundary edges, Boundary smoothing, Merge visible
+# layers. So the ninth Tab reaches the check box, whatever the fonts and the description's
+# height; space ticks it. (A wrong count ticks another box or none: check the log's "Merged".)
+gui_tick_merge_visible_layers() {
+  xdotool windowfocus --sync "$dialog"; sleep 0.5
+  for _ in $(seq 9); do xdotool key Tab; sleep 0.2; done
+  xdotool key space; sleep 1
+  import -window root "$out/merge_ticked.png"
+}
+
 # gui_apply_and_close: presses the dialog's Apply, waits (up to 2 minutes) for MeshLab to log
 # the filter as applied, presses Close; screenshot result.png, MeshLab's log in OUT_DIR.
 gui_apply_and_close() {

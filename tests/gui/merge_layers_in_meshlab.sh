@@ -53,16 +53,7 @@ PY
 gui_start "$work/project.aln"
 gui_check_loaded
 gui_open_filter_dialog
-# MeshLab gives the dialog's Apply button the keyboard focus. The focus chain then runs through
-# the parameters' scroll area and the "Copy PyMeshLab call" button (both made before the
-# parameter widgets) to the parameters in order: Resolution, Implicit function, Implicit mesh
-# layer, SODS occupancy, Min boundary edges, Boundary smoothing, Merge visible layers. So the
-# ninth Tab reaches the check box, whatever the fonts and the description's height; space
-# ticks it. (A wrong count would tick another box or none: the log check below catches it.)
-xdotool windowfocus --sync "$dialog"; sleep 0.5
-for _ in $(seq 9); do xdotool key Tab; sleep 0.2; done
-xdotool key space; sleep 1
-import -window root "$out/merge_ticked.png"
+gui_tick_merge_visible_layers
 gui_apply_and_close
 
 merged=$(grep -o "Merged [0-9]* visible layers: [0-9]* samples" "$work/meshlab.log") ||
