@@ -89,8 +89,10 @@ def _run(pymeshlab, implicit_boundaries, points, normals, params, mesh_layer=Non
     except pymeshlab.PyMeshLabException as e:
         return {"status": "refused", "message": str(e), "new_layers": ms.mesh_number() - layers}
     out = ms.current_mesh()
+    holes = ms.mesh(layers + 1) if ms.mesh_number() > layers + 1 else None
     return {"status": "ok", "surface_layer": layers, "new_layers": ms.mesh_number() - layers, "current": ms.current_mesh_id(),
             "vertices": out.vertex_matrix().copy(), "faces": out.face_matrix().copy(),
+            "holes": None if holes is None else (holes.vertex_matrix().copy(), holes.face_matrix().copy()),
             "selected": np.flatnonzero(out.vertex_selection_array()),
             "result": {k: (np.asarray(v) if isinstance(v, (list, np.ndarray)) else v) for k, v in result.items()}}
 
@@ -345,6 +347,17 @@ def check_answer(answer, params):
     assert result["surface_faces"] == len(faces) and result["surface_vertices"] == len(vertices)
     check_oriented_manifold(vertices, faces)
     check_loops(vertices, faces, result, answer["selected"])
+    if answer["holes"] is None:
+        return
+    # The holes layer closes kept holes along their loops: with the surface, welded where their
+    # vertices coincide, a 2-manifold too. (Unless distinct vertices of one layer coincide: at
+    # 1e-6 scales 1e6 from the origin, doubles cannot tell them apart, nor the weld.)
+    hole_vertices, hole_faces = answer["holes"]
+    assert len(hole_faces) == result["hole_faces"]
+    if len(np.unique(vertices, axis=0)) == len(vertices) and len(np.unique(hole_vertices, axis=0)) == len(hole_vertices):
+        both, index = np.unique(np.vstack([vertices, hole_vertices]), axis=0, return_inverse=True)
+        index = index.reshape(-1)
+        check_oriented_manifold(both, np.vstack([index[faces], index[len(vertices) + hole_faces]]))
 
 
 def run_recipe(worker, recipe, params):
@@ -462,6 +475,10 @@ FOUND = {
     # stray vertex (not a manifold)
     "centre vertex, segfault": (THREE_CLUSTERS, dict(PLAIN_OVER_CLUSTERS, sample_radius=4.0, boundary_trim=4.0), None),
     "centre vertex, not manifold": (THREE_CLUSTERS, PLAIN_OVER_CLUSTERS, None),
+    # The holes layer had pinched vertices (hole-search cells touching at a corner): with the
+    # surface, not a 2-manifold
+    "holes layer pinch": ({**SMALL_CLUSTER, "n": 94, "shapes": ["cluster", "line"]},
+                          dict(sample_radius=3.0, min_boundary_edges=0, boundary_trim=0.0, hole_layer=True), None),
 }
 
 

@@ -359,8 +359,16 @@ private:
         r.seam_points = size_t(seam.rows());
         const std::vector<char> inSurface =
             Boundaries(surface, mc, samples, spacing, seam, f, lattice.cell_size, p, r);
-        if (holes)
-            Split(surface, inSurface, 0, *holes);
+        if (holes) {
+            // The hole faces come from marching cubes over whatever cells the hole search
+            // reached; where two of those touch only at a corner, their fans meet in a pinch.
+            // Their smaller fans are left out, so that the holes layer, alone and with the
+            // surface, stays a 2-manifold.
+            std::vector<char> inHoles(inSurface.size());
+            std::transform(inSurface.begin(), inSurface.end(), inHoles.begin(), [](char s) { return char(!s); });
+            Pinches::Resolve(surface, inHoles);
+            Split(surface, inHoles, 1, *holes);
+        }
         KeepSurface(surface, inSurface);
         // An empty layer would look like success: say why nothing came out instead.
         if (surface.face.empty())
