@@ -70,7 +70,7 @@ fuzz: plugin
 # installed from Help > Plugin Info > Load Plugins and found after a restart, then run from the
 # Filters menu on one scan (its surface exported and compared with pymeshlab's, made with the
 # double plugin: same loops, within 1e-4 of the diagonal), then on two aligned scans merged. gui-double: the same with MeshLab 2025.07d and the double plugin (pymeshlab's).
-gui: plugin-float
+gui: plugin plugin-float
 	.ci/install-plugin "$$(.ci/meshlab-gui float)" $(DOUBLE_PLUGIN) $(FLOAT_PLUGIN) | grep "installed the float plugin"
 	tests/gui/load_plugin_from_dialog_in_meshlab.sh "$$(.ci/meshlab-gui float)" $(FLOAT_PLUGIN) out/gui-load-plugin
 	tests/gui/apply_filter_in_meshlab.sh "$$(.ci/meshlab-gui float)" $(FLOAT_PLUGIN) out/gui
