@@ -1,6 +1,7 @@
 """The wheel carries the compiled plugin (lib/libfilter_implicit_boundaries.so, built by `make
 plugin`), so it is a platform wheel tied to this Python and pymeshlab 2025.7.post1, not a
 pure-Python one; the rest of the metadata is in pyproject.toml."""
+import sys
 from pathlib import Path
 
 from setuptools import setup
@@ -14,6 +15,7 @@ class PluginDistribution(Distribution):
         return True
 
 
-if not PLUGIN.is_file():
+# Only the wheel must carry the plugin: the editable install (make deps) comes before the build.
+if "bdist_wheel" in sys.argv and not PLUGIN.is_file():
     raise SystemExit(f"{PLUGIN} is not built: run 'make plugin' (or 'make wheel') at the repository root first")
 setup(distclass=PluginDistribution)
