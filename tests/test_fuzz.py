@@ -479,6 +479,11 @@ FOUND = {
     # surface, not a 2-manifold
     "holes layer pinch": ({**SMALL_CLUSTER, "n": 94, "shapes": ["cluster", "line"]},
                           dict(sample_radius=3.0, min_boundary_edges=0, boundary_trim=0.0, hole_layer=True), None),
+    # A hole fan touching the surface only at a vertex, across an opening of the extraction: each
+    # layer a 2-manifold, welded a bow-tie (found after 1,711 examples of `make fuzz`)
+    "holes layer bow-tie with the surface": ({**SMALL_CLUSTER, "n": 2402},
+                                             dict(sods_occupancy="Sample cells (paper)", min_boundary_edges=0,
+                                                  boundary_trim=0.0, hole_layer=True), None),
 }
 
 

@@ -362,11 +362,11 @@ private:
         if (holes) {
             // The hole faces come from marching cubes over whatever cells the hole search
             // reached; where two of those touch only at a corner, their fans meet in a pinch.
-            // Their smaller fans are left out, so that the holes layer, alone and with the
-            // surface, stays a 2-manifold.
+            // Their smaller fans, and fans that touch the surface only at a vertex, are left
+            // out, so that the holes layer, alone and with the surface, stays a 2-manifold.
             std::vector<char> inHoles(inSurface.size());
             std::transform(inSurface.begin(), inSurface.end(), inHoles.begin(), [](char s) { return char(!s); });
-            Pinches::Resolve(surface, inHoles);
+            Pinches::Resolve(surface, inHoles, 8, &inSurface);
             Split(surface, inHoles, 1, *holes);
         }
         KeepSurface(surface, inSurface);

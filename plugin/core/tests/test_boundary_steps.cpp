@@ -236,6 +236,29 @@ TEST(BoundarySteps, PinchKeepsTheLargerFan)
     EXPECT_EQ(inSurface, (std::vector<char>{1, 1, 1, 0}));
 }
 
+TEST(BoundarySteps, HoleFanTouchingTheSurfaceOnlyAtAVertexIsLeftOut)
+{
+    // Around the origin: a surface face (0), a hole face sharing its edge (1), and a larger
+    // hole fan (2, 3) across an opening, touching both only at the origin.
+    CoreMesh m;
+    const vcg::Point3d o(0, 0, 0);
+    AddTriangle(m, o, vcg::Point3d(1, 0, 0), vcg::Point3d(1, 1, 0));
+    AddTriangle(m, o, vcg::Point3d(1, 1, 0), vcg::Point3d(0, 1, 0));
+    AddTriangle(m, o, vcg::Point3d(-1, 0, 0), vcg::Point3d(-1, -1, 0));
+    AddTriangle(m, o, vcg::Point3d(-1, -1, 0), vcg::Point3d(0, -1, 0));
+    vcg::tri::Clean<CoreMesh>::RemoveDuplicateVertex(m);
+    vcg::tri::Allocator<CoreMesh>::CompactEveryVector(m);
+    vcg::tri::UpdateTopology<CoreMesh>::FaceFace(m);
+    const std::vector<char> inSurface{1, 0, 0, 0};
+    std::vector<char> inHoles{0, 1, 1, 1};
+    // Alone, the holes layer would keep its larger fan and meet the surface in a bow-tie.
+    std::vector<char> alone = inHoles;
+    EXPECT_EQ(Pinches::Resolve(m, alone), 1u);
+    EXPECT_EQ(alone, (std::vector<char>{0, 0, 1, 1}));
+    EXPECT_EQ(Pinches::Resolve(m, inHoles, 8, &inSurface), 2u);
+    EXPECT_EQ(inHoles, (std::vector<char>{0, 1, 0, 0}));
+}
+
 TEST(BoundarySteps, ScrapsBelowTheSizeAreRemoved)
 {
     CoreMesh m;
