@@ -131,6 +131,10 @@ public:
     /// the boundaries: measured on the Stanford bunny scan (bun_zipper, 34,834 samples), 0.6
     /// finds all 5 holes as single loops (1.0 merges the smallest into undersampling noise).
     static constexpr double kCellPerSpacing = 0.6;
+    /// A tangent disk is at least this many of its sample's local spacings thick on each side:
+    /// the thinnest slab it has at the automatic resolution (half a cell plus the slack, for a
+    /// normal along an axis).
+    static constexpr double kSlabPerSpacing = kCellPerSpacing * (0.5 + kDiskSlack);
     /// Surface faces within this many median spacings of an orientation seam are cut away: the
     /// walls a signed implicit function forms where the normals flip reach about 1.75 spacings
     /// to either side (Möbius strip, both implicit functions).
@@ -326,11 +330,22 @@ private:
         t = Clock::now();
         if (cb) cb(36, "Building the spatial occupancy data structure");
         // At a thin part's rim the surface turns between the two sides' flat disks: there they
-        // reach half way to the other side.
+        // reach half way to the other side. Where the cells are finer than the automatic
+        // resolution's for a sample's spacing (the sparse parts of an unevenly sampled scan, a
+        // resolution set by hand), its disk is at least as thick as there (kSlabPerSpacing):
+        // flat disks a cell or two thick lost the curved surface at their rims (a unit sphere
+        // sampled 0.11 apart, on 0.0055 cells, leaves the plane by 1.1 cells one spacing away).
+        // Where the cells are finer than the automatic resolution's, every disk keeps the reach
+        // it has there: the random gaps between samples, no longer bridged by the cells, opened
+        // as holes. (A reach from each sample's own spacing, and slabs as thick as the automatic
+        // resolution's for every normal direction, closed the smallest real holes of bun_zipper
+        // and fertility: samples at a hole's rim have one-sided neighbourhoods, so larger
+        // spacings.)
         const Eigen::VectorXd foldWidth = OrientationSeam::FoldWidths(samples, normals, spacing, p.threads, scan);
         Sods sods = p.occupancy == Occupancy::TangentDisks
                         ? Sods::FromDisks(lattice, OnZeroSet(P, normals, f), normals, p.sample_radius * spacing,
-                                          kDiskSlack * lattice.cell_size, p.threads, 0.5 * foldWidth)
+                                          kDiskSlack * lattice.cell_size, p.threads, 0.5 * foldWidth,
+                                          kSlabPerSpacing * spacing, kCellPerSpacing * r.sample_spacing)
                         : Sods::FromSamples(lattice, P);
         for (int i = 0; i < p.sods_dilation; ++i)
             sods = sods.Dilated();

@@ -35,10 +35,14 @@ public:
     /// normal N.row(i) covers the disk of radius radius[i] around it in its tangent plane,
     /// thickened by `slack` (world units) on each side along the normal, plus thickness[i] when
     /// given (empty: none; e.g. half the distance to the other side at a thin part's rim, where
-    /// the surface turns between two sheets of flat disks). With radii from the local sample
-    /// spacing, sparse regions stay covered while gaps wider than two radii stay open.
+    /// the surface turns between two sheets of flat disks). A cell counts when the disk passes
+    /// within half a cell of its centre. Disk i is at least minSlab[i] thick on each side
+    /// (when given), and where the lattice is finer than reachCell it keeps the reach it has on
+    /// cells of reachCell. With radii from the local sample spacing, sparse regions stay
+    /// covered while gaps wider than two radii stay open.
     static Sods FromDisks(const Lattice& lattice, const Points& P, const Points& N, const Eigen::VectorXd& radius,
-                          double slack, int threads = 0, const Eigen::VectorXd& thickness = Eigen::VectorXd())
+                          double slack, int threads = 0, const Eigen::VectorXd& thickness = Eigen::VectorXd(),
+                          const Eigen::VectorXd& minSlab = Eigen::VectorXd(), double reachCell = 0)
     {
         // One occupancy per block of samples, OR-ed together: the result does not depend on
         // the thread count.
@@ -50,7 +54,8 @@ public:
             for (size_t b = begin; b < end; ++b)
                 for (Eigen::Index i = Eigen::Index(b) * per; i < std::min(P.rows(), Eigen::Index(b + 1) * per); ++i)
                     parts[b].InsertDisk(lattice, P.row(i).transpose(), N.row(i).transpose(), radius[i],
-                                        slack + (thickness.size() ? thickness[i] : 0.0));
+                                        slack, thickness.size() ? thickness[i] : 0.0,
+                                        minSlab.size() ? minSlab[i] : 0.0, reachCell);
         }, 1);
         for (size_t b = 1; b < parts.size(); ++b)
             parts[0].Merge(parts[b]);
@@ -71,12 +76,15 @@ public:
     }
 
     /// Adds the cells of one tangent disk (see FromDisks).
-    void InsertDisk(const Lattice& lattice, const Eigen::Vector3d& p, const Eigen::Vector3d& n, double r, double slack)
+    void InsertDisk(const Lattice& lattice, const Eigen::Vector3d& p, const Eigen::Vector3d& n, double r, double slack,
+                    double thickness = 0, double minSlab = 0, double reachCell = 0)
     {
         const double a = 0.5 * lattice.cell_size;
-        const double slab = a * n.cwiseAbs().sum() + slack;
-        const double reach = r + a * std::sqrt(3.0);
-        const Eigen::Vector3d box = Eigen::Vector3d::Constant(std::max(r, slack));
+        const double wider = std::max(1.0, reachCell / lattice.cell_size);
+        const double slab = std::max(a * n.cwiseAbs().sum() + slack, minSlab) + thickness;
+        const double reach = r + wider * a * std::sqrt(3.0);
+        const Eigen::Vector3d box =
+            Eigen::Vector3d::Constant(std::max(r + (wider - 1) * a * std::sqrt(3.0), std::max(slack, minSlab) + thickness));
         const Index3 lo = lattice.CellOf(p - box), hi = lattice.CellOf(p + box);
         // Neighbouring cells mostly share a brick: keep the last one instead of hashing each
         // cell (map elements do not move when the map grows).

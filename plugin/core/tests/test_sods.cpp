@@ -85,6 +85,32 @@ TEST(Sods, TangentDiskCoversItsPlaneOnly)
     s.ForEach([](const Index3& c) { EXPECT_EQ(c[2], 5); });
 }
 
+TEST(Sods, TangentDiskKeepsItsShapeOnFinerCells)
+{
+    // The disk of TangentDiskCoversItsPlaneOnly on cells 4 times finer (0.25), at least 0.5
+    // thick and with the reach of unit cells: it reaches and is as thick as it is on unit
+    // cells, in world units; without, only a quarter as thick.
+    Points P(1, 3), N(1, 3);
+    P << 5.5, 5.5, 5.5;
+    N << 0, 0, 1;
+    Lattice fine;
+    fine.cell_size = 0.25;
+    fine.cells = Index3(48, 48, 48);
+    const Eigen::VectorXd r = Eigen::VectorXd::Constant(1, 2.2);
+    const Sods shaped = Sods::FromDisks(fine, P, N, r, 0.0, 1, Eigen::VectorXd(), Eigen::VectorXd::Constant(1, 0.5), 1.0);
+    const Sods flat = Sods::FromDisks(fine, P, N, r, 0.0, 1);
+    // The cell centred 0.375 above the plane: within the unit-cell slab of 0.5, not within 0.125.
+    EXPECT_TRUE(shaped.Contains(Index3(22, 22, 23)));
+    EXPECT_FALSE(flat.Contains(Index3(22, 22, 23)));
+    EXPECT_FALSE(shaped.Contains(Index3(22, 22, 24)));  // 0.625 above
+    // Along the plane, the reach is 2.2 + the unit cell's half diagonal (0.87): the cell centred
+    // 2.875 away is in, 3.125 is not; flat disks reach 2.2 + 0.22.
+    EXPECT_TRUE(shaped.Contains(Index3(33, 22, 22)));
+    EXPECT_FALSE(shaped.Contains(Index3(34, 22, 22)));
+    EXPECT_FALSE(flat.Contains(Index3(32, 22, 22)));
+    EXPECT_GT(shaped.Count(), 2 * flat.Count());
+}
+
 TEST(Sods, TangentDisksOfUniformSamplesLeaveNoGapAtFineCells)
 {
     // Samples on a 1-spaced grid in a tilted plane, cells of 0.3: every cell the plane crosses
