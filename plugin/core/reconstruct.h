@@ -133,8 +133,11 @@ public:
     static constexpr double kCellPerSpacing = 0.6;
     /// A tangent disk is at least this many of its sample's local spacings thick on each side:
     /// the thinnest slab it has at the automatic resolution (half a cell plus the slack, for a
-    /// normal along an axis).
-    static constexpr double kSlabPerSpacing = kCellPerSpacing * (0.5 + kDiskSlack);
+    /// normal along an axis), for the spacing divided by √2. A sample on the edge of a scan or
+    /// a hole finds its neighbours in a half disk, which makes its spacing up to √2 larger; a
+    /// slab from that spacing closed the smallest real holes of bun_zipper, fertility and
+    /// pymeshlab's bunny.
+    static constexpr double kSlabPerSpacing = kCellPerSpacing * (0.5 + kDiskSlack) / M_SQRT2;
     /// Surface faces within this many median spacings of an orientation seam are cut away: the
     /// walls a signed implicit function forms where the normals flip reach about 1.75 spacings
     /// to either side (Möbius strip, both implicit functions).
