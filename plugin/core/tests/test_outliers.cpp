@@ -58,6 +58,23 @@ TEST(Outliers, FindsStraysAloneAndInSmallGroups)
         EXPECT_EQ(kept[i], Eigen::Index(i));
 }
 
+TEST(Outliers, FindsAScatterOfStraysThatClaimEachOther)
+{
+    // Twelve strays scattered a unit apart in the empty space beside the scan: each is among
+    // the nearest of the others, so each is claimed, but as a group they are too few and too
+    // sparse to be a surface.
+    std::vector<Eigen::RowVector3d> ps = UnevenPlane();
+    const size_t surface = ps.size();
+    std::mt19937 rng(2);
+    std::uniform_real_distribution<double> u(-0.3, 0.3);
+    for (int i = 0; i < 12; ++i)
+        ps.emplace_back(4 + (i % 3) + u(rng), 4 + (i / 3 % 2) + u(rng), 2 + (i / 6) + u(rng));
+    const Points P = Stack(ps);
+    const std::vector<Eigen::Index> kept = Outliers::Kept(SampleIndex(P));
+    ASSERT_EQ(kept.size(), surface);
+    EXPECT_EQ(kept.back(), Eigen::Index(surface - 1));
+}
+
 TEST(Outliers, KeepsEveryOneOfFewSamples)
 {
     const Points P = Stack({{0, 0, 0}, {1, 0, 0}, {100, 0, 0}});
