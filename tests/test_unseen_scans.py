@@ -74,6 +74,27 @@ def test_random_samples_of_an_open_surface_have_one_loop(plugin, cells_per_spaci
     assert np.abs(np.linalg.norm(rec.vertices, axis=1) - radius).max() < 0.5 * rec.info["sample_spacing"]
 
 
+@pytest.mark.parametrize("seed", [0, 2])
+def test_strays_in_the_empty_space_around_a_scan_are_left_out(plugin, seed):
+    """A unit sphere of 20,000 samples, 20 strays drawn in the box three times its size (the
+    empty space around a scan, where strays are each other's nearest) and one sample far away.
+    Before: 3 (seed 0) and 9 (seed 2) strays claimed each other and stayed; their tangent disks,
+    as wide as the gaps between them, put 337,075 and 9,766,464 cells in the SODS (114,391
+    without them) and halved the lattice cell. Now every stray is left out: the SODS and the
+    lattice are the clean scan's."""
+    rng = np.random.default_rng(seed)
+    points = fibonacci_sphere(20000)
+    clean = implicit_boundaries.reconstruct(points, points)
+    strays, stray_normals = stray_points(rng, 20, -3, 3)
+    far = np.array([[10 * np.sqrt(12), 0, 0]])
+    rec = implicit_boundaries.reconstruct(np.vstack([points, strays, far]),
+                                          np.vstack([points, stray_normals, [[1, 0, 0]]]))
+    assert rec.info["outliers_removed"] == 21
+    assert rec.info["resolution"] == clean.info["resolution"]
+    assert rec.info["sods_cells"] == clean.info["sods_cells"]
+    assert rec.loops == []
+
+
 def test_a_thin_plate_three_spacings_thick_stays_closed():
     """A closed plate whose sides are 3 sample spacings apart (an ear, a fin), exact normals: no
     loop. Its rim was cut as an orientation seam (opposite normals in each other's tangent
