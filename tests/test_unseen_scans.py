@@ -18,6 +18,19 @@ def stray_points(rng, count, lo, hi):
     return points, normals / np.linalg.norm(normals, axis=1, keepdims=True)
 
 
+def sphere_with_strays(seed, half_box):
+    """A unit sphere of 20,000 samples reconstructed alone (`clean`) and with 20 strays drawn in
+    the box [-half_box, half_box]³ plus one sample at ten times its diagonal (`rec`)."""
+    rng = np.random.default_rng(seed)
+    points = fibonacci_sphere(20000)
+    clean = implicit_boundaries.reconstruct(points, points)
+    strays, stray_normals = stray_points(rng, 20, -half_box, half_box)
+    far = np.array([[10 * np.sqrt(12), 0, 0]])
+    rec = implicit_boundaries.reconstruct(np.vstack([points, strays, far]),
+                                          np.vstack([points, stray_normals, [[1, 0, 0]]]))
+    return clean, rec, strays
+
+
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_outliers_are_left_out(plugin, seed):
     """A unit sphere of 20,000 samples, plus 0.1% of strays drawn in its bounding box and one
@@ -25,13 +38,7 @@ def test_outliers_are_left_out(plugin, seed):
     stray's tangent disk, as wide as the gap around it, showed a sheet of the implicit
     function's surface around it, up to 17 spacings off the sphere. Now the strays are left
     out (counted), the lattice is the clean scan's, and the sphere stays closed."""
-    rng = np.random.default_rng(seed)
-    points = fibonacci_sphere(20000)
-    clean = implicit_boundaries.reconstruct(points, points)
-    strays, stray_normals = stray_points(rng, 20, -1, 1)
-    far = np.array([[10 * np.sqrt(12), 0, 0]])
-    rec = implicit_boundaries.reconstruct(np.vstack([points, strays, far]),
-                                          np.vstack([points, stray_normals, [[1, 0, 0]]]))
+    clean, rec, strays = sphere_with_strays(seed, 1)
     spacing = clean.info["sample_spacing"]
     assert rec.info["resolution"] == clean.info["resolution"]
     assert rec.loops == []
@@ -82,13 +89,7 @@ def test_strays_in_the_empty_space_around_a_scan_are_left_out(plugin, seed):
     as wide as the gaps between them, put 337,075 and 9,766,464 cells in the SODS (114,391
     without them) and halved the lattice cell. Now every stray is left out: the SODS and the
     lattice are the clean scan's."""
-    rng = np.random.default_rng(seed)
-    points = fibonacci_sphere(20000)
-    clean = implicit_boundaries.reconstruct(points, points)
-    strays, stray_normals = stray_points(rng, 20, -3, 3)
-    far = np.array([[10 * np.sqrt(12), 0, 0]])
-    rec = implicit_boundaries.reconstruct(np.vstack([points, strays, far]),
-                                          np.vstack([points, stray_normals, [[1, 0, 0]]]))
+    clean, rec, _ = sphere_with_strays(seed, 3)
     assert rec.info["outliers_removed"] == 21
     assert rec.info["resolution"] == clean.info["resolution"]
     assert rec.info["sods_cells"] == clean.info["sods_cells"]
