@@ -333,17 +333,15 @@ private:
         t = Clock::now();
         if (cb) cb(36, "Building the spatial occupancy data structure");
         // At a thin part's rim the surface turns between the two sides' flat disks: there they
-        // reach half way to the other side. Where the cells are finer than the automatic
-        // resolution's for a sample's spacing (the sparse parts of an unevenly sampled scan, a
-        // resolution set by hand), its disk is at least as thick as there (kSlabPerSpacing):
-        // flat disks a cell or two thick lost the curved surface at their rims (a unit sphere
-        // sampled 0.11 apart, on 0.0055 cells, leaves the plane by 1.1 cells one spacing away).
-        // Where the cells are finer than the automatic resolution's, every disk keeps the reach
-        // it has there: the random gaps between samples, no longer bridged by the cells, opened
-        // as holes. (A reach from each sample's own spacing, and slabs as thick as the automatic
-        // resolution's for every normal direction, closed the smallest real holes of bun_zipper
-        // and fertility: samples at a hole's rim have one-sided neighbourhoods, so larger
-        // spacings.)
+        // reach half way to the other side. On cells finer than the automatic resolution's for
+        // a sample's spacing (the sparse parts of an unevenly sampled scan, a resolution set by
+        // hand) a disk keeps the shape it has there: its slab (kSlabPerSpacing), as flat disks a
+        // cell or two thick lost the curved surface at their rims (a unit sphere sampled 0.11
+        // apart, on 0.0055 cells, leaves the plane by 1.1 cells one spacing away); and the
+        // automatic cell's reach, as the random gaps between samples, no longer bridged by the
+        // cells, opened as holes. (A reach from each sample's own spacing, not the median,
+        // closed the smallest real holes of bun_zipper and fertility: samples at a hole's rim
+        // have one-sided neighbourhoods, so larger spacings.)
         const Eigen::VectorXd foldWidth = OrientationSeam::FoldWidths(samples, normals, spacing, p.threads, scan);
         Sods sods = p.occupancy == Occupancy::TangentDisks
                         ? Sods::FromDisks(lattice, OnZeroSet(P, normals, f), normals, p.sample_radius * spacing,

@@ -35,11 +35,12 @@ public:
     /// normal N.row(i) covers the disk of radius radius[i] around it in its tangent plane,
     /// thickened by `slack` (world units) on each side along the normal, plus thickness[i] when
     /// given (empty: none; e.g. half the distance to the other side at a thin part's rim, where
-    /// the surface turns between two sheets of flat disks). A cell counts when the disk passes
-    /// within half a cell of its centre. Disk i is at least minSlab[i] thick on each side
-    /// (when given), and where the lattice is finer than reachCell it keeps the reach it has on
-    /// cells of reachCell. With radii from the local sample spacing, sparse regions stay
-    /// covered while gaps wider than two radii stay open.
+    /// the surface turns between two sheets of flat disks). A cell counts when its centre lies
+    /// within that slab widened by the cell's half extent along the normal, and within the
+    /// radius plus half a cell diagonal along the plane. Disk i is at least minSlab[i] thick on
+    /// each side (when given), and where the lattice is finer than reachCell it keeps the reach
+    /// it has on cells of reachCell. With radii from the local sample spacing, sparse regions
+    /// stay covered while gaps wider than two radii stay open.
     static Sods FromDisks(const Lattice& lattice, const Points& P, const Points& N, const Eigen::VectorXd& radius,
                           double slack, int threads = 0, const Eigen::VectorXd& thickness = Eigen::VectorXd(),
                           const Eigen::VectorXd& minSlab = Eigen::VectorXd(), double reachCell = 0)
