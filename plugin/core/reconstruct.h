@@ -320,8 +320,10 @@ private:
         r.lattice_corners = lattice.CornerCount();
         r.memory_limit = p.memory_limit > 0 ? p.memory_limit : MemoryBudget::Default();
         // Before the implicit function, the largest per-sample cost: a surface of n samples at
-        // spacing s covers about n·s² / cell² cells.
-        const double expectedCells = 2.0 * double(P.rows()) * std::pow(r.sample_spacing / cell, 2);
+        // spacing s covers about n·s² / cell² cells, in a layer two cells thick, or as thick as
+        // the tangent disks' slab on cells finer than the automatic resolution's.
+        const double expectedCells = double(P.rows()) * std::pow(r.sample_spacing / cell, 2) *
+                                     std::max(2.0, 2 * kSlabPerSpacing * r.sample_spacing / cell);
         CheckMemory(p.extraction, lattice, double(input.rows()), expectedCells, r);
         const std::unique_ptr<ImplicitFunction> fitted =
             p.implicit == Implicit::Given ? nullptr : MakeImplicit(P, normals, samples, p, cb);
