@@ -46,18 +46,20 @@ public:
         // Claims from several threads land on the same samples: atomic counters (the result
         // does not depend on the order).
         std::unique_ptr<std::atomic<int>[]> claims(new std::atomic<int>[size_t(n)]());
-        ForEachNeighbour(samples, threads, [&](Eigen::Index, Eigen::Index j) {
+        std::vector<double> reach(size_t(n), 0);  // squared distance to the kNeighbours-th nearest
+        ForEachNeighbour(samples, threads, [&](Eigen::Index i, Eigen::Index j, double d2) {
             claims[size_t(j)].fetch_add(1, std::memory_order_relaxed);
+            reach[size_t(i)] = std::max(reach[size_t(i)], d2);  // i's own slot: one thread
         });
         std::unique_ptr<std::atomic<char>[]> claimed(new std::atomic<char>[size_t(n)]());
-        ForEachNeighbour(samples, threads, [&](Eigen::Index i, Eigen::Index j) {
+        ForEachNeighbour(samples, threads, [&](Eigen::Index i, Eigen::Index j, double) {
             if (claims[size_t(i)].load(std::memory_order_relaxed) >= kNeighbours / 2)
                 claimed[size_t(j)].store(1, std::memory_order_relaxed);
         });
         std::vector<char> keep(size_t(n), 0);
         for (Eigen::Index i = 0; i < n; ++i)
             keep[size_t(i)] = claimed[size_t(i)].load(std::memory_order_relaxed);
-        DropSparseGroups(samples, keep, threads);
+        DropSparseGroups(samples, reach, keep);
         for (Eigen::Index i = 0; i < n; ++i)
             if (keep[size_t(i)])
                 kept.push_back(i);
@@ -75,18 +77,11 @@ public:
     static constexpr size_t kMinGroup = 2 * kNeighbours;
 
 private:
-    /// Clears keep[i] for the samples of sparse groups among those kept.
-    static void DropSparseGroups(const SampleIndex& samples, std::vector<char>& keep, int threads)
+    /// Clears keep[i] for the samples of sparse groups among those kept; reach[i]: the squared
+    /// distance from sample i to its kNeighbours-th nearest.
+    static void DropSparseGroups(const SampleIndex& samples, const std::vector<double>& reach, std::vector<char>& keep)
     {
         const Eigen::Index n = samples.Size();
-        std::vector<double> reach(size_t(n), 0);  // squared distance to the kNeighbours-th nearest
-        ParallelFor(size_t(n), threads, [&](size_t begin, size_t end, int) {
-            SampleIndex::Queue queue;
-            for (size_t i = begin; i < end; ++i) {
-                samples.Nearest(samples.P().row(Eigen::Index(i)).transpose(), kNeighbours + 1, queue);
-                reach[i] = queue.getTopWeight();
-            }
-        }, 256);
         std::vector<double> kept;
         for (Eigen::Index i = 0; i < n; ++i)
             if (keep[size_t(i)])
@@ -124,8 +119,8 @@ private:
                 keep[size_t(i)] = 0;
     }
 
-    /// Calls f(i, j) for every sample i and each j != i of its kNeighbours nearest, from
-    /// several threads.
+    /// Calls f(i, j, squared distance) for every sample i and each j != i of its kNeighbours
+    /// nearest, from several threads (each i from one).
     template <class F>
     static void ForEachNeighbour(const SampleIndex& samples, int threads, F&& f)
     {
@@ -135,7 +130,7 @@ private:
                 samples.Nearest(samples.P().row(Eigen::Index(i)).transpose(), kNeighbours + 1, queue);  // +1: itself
                 for (int q = 0; q < queue.getNofElements(); ++q)
                     if (size_t(queue.getIndex(q)) != i)
-                        f(Eigen::Index(i), Eigen::Index(queue.getIndex(q)));
+                        f(Eigen::Index(i), Eigen::Index(queue.getIndex(q)), double(queue.getWeight(q)));
             }
         }, 256);
     }
