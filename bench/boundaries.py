@@ -18,7 +18,7 @@ import pymeshlab
 
 import implicit_boundaries
 from implicit_boundaries import poisson_with_boundaries
-from implicit_boundaries.compare import density_trim, poisson_depth
+from implicit_boundaries.methods import density_trim, poisson_depth
 from implicit_boundaries.metrics import boundary_curves, boundary_distance, boundary_vertex_sets, loops_found
 
 DEFAULT_DATA = Path(__file__).resolve().parent.parent.parent / "shared" / "data"

@@ -24,7 +24,7 @@ import numpy as np
 import pymeshlab
 
 import implicit_boundaries
-from implicit_boundaries.compare import poisson_depth
+from implicit_boundaries.methods import poisson_depth
 from implicit_boundaries.metrics import (boundary_curves, boundary_distance, boundary_vertex_sets, point_mesh_distance,
                                         surface_distances)
 from scipy.spatial import cKDTree

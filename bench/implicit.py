@@ -29,7 +29,7 @@ import pymeshlab
 import implicit_boundaries
 from boundaries import load_case
 from extraction import synthetic_scan
-from implicit_boundaries.compare import poisson_depth
+from implicit_boundaries.methods import poisson_depth
 from implicit_boundaries.metrics import point_mesh_distance, sample_surface
 
 DEFAULT_DATA = Path(__file__).resolve().parent.parent.parent / "shared" / "data"

@@ -24,7 +24,9 @@ import implicit_boundaries
 from implicit_boundaries import metrics
 from implicit_boundaries.alignment import read_alignment
 from implicit_boundaries.cli import _point_cloud
-from implicit_boundaries.compare import Cloud, Surface, _copy, density_trim, format_value, measure, poisson_depth
+from implicit_boundaries.cloud import Cloud, mesh_arrays
+from implicit_boundaries.methods import Surface, density_trim, poisson_depth
+from implicit_boundaries.table import format_value
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from corpus import DEFAULT_DATA, parse_params  # noqa: E402
@@ -54,7 +56,7 @@ def run_ours(alignment: Path, params: dict):
     start = time.perf_counter()
     info = implicit_boundaries.apply(ms, merge_visible_layers=True, **params)
     seconds = time.perf_counter() - start
-    return Surface(*_copy(ms.current_mesh()), info=dict(info)), seconds
+    return Surface(*mesh_arrays(ms.current_mesh()), info=dict(info)), seconds
 
 
 def run_poisson(alignment: Path, depth: int, trim: float):
@@ -82,7 +84,7 @@ def main(argv=None):
     alignment = Path(args.alignment)
     truth_ms = pymeshlab.MeshSet()
     truth_ms.load_new_mesh(args.truth)
-    truth = _copy(truth_ms.current_mesh())
+    truth = mesh_arrays(truth_ms.current_mesh())
     truth_loops = [truth[0][h] for h in metrics.boundary_vertex_sets(truth[1], len(truth[0]))]
     cloud = world_cloud(scan_layers(alignment))
 
@@ -91,7 +93,7 @@ def main(argv=None):
     if args.surface:
         given = pymeshlab.MeshSet()
         given.load_new_mesh(args.surface)
-        runs = [(f"{Path(args.surface).name} (made elsewhere; time: ours here)", Surface(*_copy(given.current_mesh())), seconds)]
+        runs = [(f"{Path(args.surface).name} (made elsewhere; time: ours here)", Surface(*mesh_arrays(given.current_mesh())), seconds)]
     else:
         runs = [("ours (merge visible layers)", ours, seconds),
                 (f"screened Poisson, depth {depth} (merge visible layers)", *run_poisson(alignment, depth, 0)),
@@ -104,7 +106,7 @@ def main(argv=None):
               "spurious area %", "missing area %", "boundary distance (% diag)"]
     print("| " + " | ".join(header) + " |\n|" + "---|" * len(header))
     for name, surface, seconds in runs:
-        row = measure(surface, cloud, truth, truth_loops, tolerance)
+        row = metrics.measure(surface.vertices, surface.faces, cloud, truth, truth_loops, tolerance)
         farthest = metrics.point_mesh_distance(surface.vertices, *truth).max() / diagonal
         cells = [name, seconds, row["loops"], row["loops_found"], 100 * farthest, row["chamfer_pct"],
                  row["spurious_pct"], row["missing_pct"], row["boundary_distance_pct"]]

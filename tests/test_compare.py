@@ -5,7 +5,8 @@ from PIL import Image
 
 import implicit_boundaries
 from implicit_boundaries import metrics
-from implicit_boundaries.compare import METHODS, Cloud, Surface, density_trim, poisson_depth
+from implicit_boundaries.cloud import Cloud
+from implicit_boundaries.methods import METHODS, Surface, density_trim, poisson_depth
 
 from scipy.spatial import ConvexHull
 

@@ -1,10 +1,13 @@
-"""Measures on meshes with boundaries, for tests, benchmarks and comparisons."""
-from typing import Dict, List, Sequence, Tuple
+"""Measures on meshes with boundaries, for tests, benchmarks and comparisons: boundary loops
+and curves, distances between meshes, and :func:`measure`, a comparison's row of one surface."""
+from typing import Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
+
+from .cloud import Cloud
 
 
 def _boundary_components(faces: np.ndarray, n_vertices: int) -> Tuple[np.ndarray, np.ndarray]:
@@ -181,3 +184,49 @@ def surface_distances(vertices, faces, truth_vertices, truth_faces, tolerance: f
     return {"chamfer": 0.5 * (to_truth.mean() + to_result.mean()),
             "spurious": float(np.mean(to_truth > tolerance)),
             "missing": float(np.mean(to_result > tolerance))}
+
+
+def supported_faces(vertices: np.ndarray, faces: np.ndarray, samples: np.ndarray, tolerance: float) -> np.ndarray:
+    """(f,) bool: the (f, 3) faces over the (m, 3) vertices with a point (centroid or a vertex)
+    within `tolerance` of one of the (n, 3) samples."""
+    if len(faces) == 0:
+        return np.zeros(0, dtype=bool)
+    tree = cKDTree(samples)
+    tri = vertices[faces]
+    near = np.stack([tree.query(p)[0] for p in [tri.mean(axis=1), tri[:, 0], tri[:, 1], tri[:, 2]]])
+    return near.min(axis=0) <= tolerance
+
+
+def unsupported_tolerance(cloud: Cloud) -> float:
+    """Faces farther than this from every sample are unsupported: 2 sample spacings."""
+    return 2 * cloud.spacing
+
+
+def measure(vertices: np.ndarray, faces: np.ndarray, cloud: Cloud, truth: Optional[Tuple[np.ndarray, np.ndarray]] = None,
+            truth_loops: Optional[Sequence[np.ndarray]] = None, loop_tolerance: float = 0.0,
+            samples: int = 20000) -> Dict[str, object]:
+    """The comparison row (see :data:`implicit_boundaries.table.COLUMNS`) of the surface with
+    (m, 3) `vertices` and (f, 3) `faces` made from `cloud`: faces, boundary loops, unsupported
+    area (farther than 2 sample spacings from every sample: what the method made up) and, with
+    a ground truth ((vertices, faces) and its boundaries as (k, 3) point arrays, `truth_loops`),
+    the yardsticks: true boundaries found (loops within `loop_tolerance`), chamfer, spurious
+    and missing area, boundary distance. Distances are % of the input's bounding-box
+    diagonal; the area tolerance is 1% of it. samples: area samples per mesh."""
+    diagonal = cloud.diagonal
+    loops = sorted(boundary_vertex_sets(faces, len(vertices)), key=len, reverse=True)
+    row: Dict[str, object] = {"faces": int(len(faces)), "loops": len(loops),
+                              "loop_sizes": [int(len(loop)) for loop in loops]}
+    areas = triangle_areas(vertices, faces)
+    supported = supported_faces(vertices, faces, cloud.points, unsupported_tolerance(cloud))
+    row["unsupported_pct"] = 100 * float(areas[~supported].sum() / areas.sum()) if len(areas) else 0.0
+    if truth is not None:
+        found, _ = loops_found(truth_loops, [vertices[loop] for loop in loops], loop_tolerance)
+        row["loops_found"] = f"{found}/{len(truth_loops)}"
+        d = surface_distances(vertices, faces, *truth, 0.01 * diagonal, samples)
+        row["chamfer_pct"] = 100 * d["chamfer"] / diagonal
+        row["spurious_pct"] = 100 * d["spurious"]
+        row["missing_pct"] = 100 * d["missing"]
+        # Between the boundary curves, sampled every 0.05% of the diagonal (within 0.025%).
+        curves = [boundary_curves(*mesh, 0.0005 * diagonal) for mesh in (truth, (vertices, faces))]
+        row["boundary_distance_pct"] = 100 * boundary_distance(*curves) / diagonal
+    return row

@@ -8,8 +8,8 @@ from typing import Callable
 import numpy as np
 import pymeshlab
 
-from . import render
-from .compare import COLUMNS, Comparison, format_value, settings_dict, supported_faces, unsupported_tolerance
+from . import metrics, render
+from .table import html_table
 
 PICTURE = "side_by_side.png"
 CHART = "metrics.png"
@@ -26,22 +26,19 @@ def _save_mesh(vertices: np.ndarray, faces: np.ndarray, path: Path) -> None:
     ms.save_current_mesh(str(path))
 
 
-def _table(comparison: Comparison) -> str:
-    keys = [k for k in COLUMNS if any(k in row for row in comparison.rows)]
-    head = "".join(f"<th>{html.escape(COLUMNS[k])}</th>" for k in keys)
-    body = "".join("<tr>" + "".join(f"<td>{html.escape(format_value(row.get(k)))}</td>" for k in keys) + "</tr>"
-                   for row in comparison.rows)
-    return f"<table><tr>{head}</tr>{body}</table>"
+def write_report(comparison, folder: Path, progress: Callable[[str], None] = lambda what: None) -> Path:
+    """Writes folder/report.html, its two pictures and a PLY per method; returns the HTML path.
 
-
-def write_report(comparison: Comparison, folder: Path, progress: Callable[[str], None] = lambda what: None) -> Path:
-    """Writes folder/report.html, its two pictures and a PLY per method; returns the HTML path."""
+    comparison: a :class:`implicit_boundaries.compare.Comparison` (not imported here: compare
+    imports this module). progress(next step) is called before each step.
+    """
     folder.mkdir(parents=True, exist_ok=True)
     cloud = comparison.cloud
     progress("rendering")
     panels = []
     for name, surface in comparison.surfaces.items():
-        supported = supported_faces(surface, cloud, unsupported_tolerance(cloud))
+        supported = metrics.supported_faces(surface.vertices, surface.faces, cloud.points,
+                                            metrics.unsupported_tolerance(cloud))
         panels.append((name, surface.vertices, surface.faces, supported, surface.holes))
         _save_mesh(surface.vertices, surface.faces, folder / f"{slug(name)}.ply")
     render.side_by_side(panels, cloud.points, folder / PICTURE)
@@ -51,7 +48,7 @@ def write_report(comparison: Comparison, folder: Path, progress: Callable[[str],
     parameters = dict(comparison.sources)
     parameters.update({"samples": len(cloud.points), "bounding-box diagonal": f"{cloud.diagonal:.4g}",
                        "median sample spacing": f"{cloud.spacing:.4g}", "pymeshlab": metadata.version("pymeshlab")})
-    parameters.update(settings_dict(comparison.settings))
+    parameters.update(comparison.settings.as_dict())
     meshes = " · ".join(f'<a href="{slug(n)}.ply">{html.escape(n)}</a>' for n in comparison.surfaces)
     page = f"""<!DOCTYPE html>
 <html><head><meta charset="utf-8"><title>Implicit reconstruction with boundaries vs screened Poisson</title>
@@ -64,7 +61,7 @@ longest side, Poisson octree depth {comparison.settings.depth}. Distances and ar
 bounding-box diagonal; an area is spurious (missing) when farther than 1% of it from the truth (from the result),
 unsupported when farther than 2 sample spacings ({2 * cloud.spacing:.3g}) from every sample.</p>
 <h2>Results</h2>
-{_table(comparison)}
+{html_table(comparison.rows)}
 <p>Meshes: {meshes}</p>
 <h2>Pictures</h2>
 <p>Same camera for every method; top row from the side of our boundaries, bottom row from the opposite side.

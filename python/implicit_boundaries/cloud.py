@@ -1,0 +1,70 @@
+"""The input point cloud: reading it from a file, and handing it to pymeshlab as a layer."""
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Tuple, Union
+
+import numpy as np
+import pymeshlab
+from scipy.spatial import cKDTree
+
+
+@dataclass
+class Cloud:
+    """The input: (n, 3) points and (n, 3) unit normals (oriented outwards)."""
+    points: np.ndarray
+    normals: np.ndarray
+
+    @property
+    def diagonal(self) -> float:
+        """Length of the points' bounding-box diagonal."""
+        return float(np.linalg.norm(self.points.max(axis=0) - self.points.min(axis=0)))
+
+    @property
+    def spacing(self) -> float:
+        """Median distance from a sample to its nearest other sample."""
+        return float(np.median(cKDTree(self.points).query(self.points, k=2)[0][:, 1]))
+
+
+def mesh_arrays(mesh: pymeshlab.Mesh) -> Tuple[np.ndarray, np.ndarray]:
+    """(vertices (m, 3), faces (f, 3)) of a pymeshlab mesh, compacted first (deleted elements
+    would otherwise keep their rows), copied out of pymeshlab's memory."""
+    mesh.compact()
+    return mesh.vertex_matrix().copy(), mesh.face_matrix().copy()
+
+
+def _load(path: Path) -> pymeshlab.MeshSet:
+    if not path.is_file():
+        raise FileNotFoundError(f"{path}: no such file")
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(str(path))
+    return ms
+
+
+def read_cloud(path: Union[str, Path]) -> Cloud:
+    """The vertices and normals of any file pymeshlab reads (faces ignored); normals are
+    estimated (10 neighbours) when the file has none."""
+    path = Path(path)
+    ms = _load(path)
+    mesh = ms.current_mesh()
+    mesh.compact()
+    if mesh.vertex_number() == 0:
+        raise ValueError(f"{path}: no vertices")
+    if not np.any(mesh.vertex_normal_matrix()):
+        ms.compute_normal_for_point_clouds(k=10)
+        mesh = ms.current_mesh()
+    return Cloud(mesh.vertex_matrix().copy(), mesh.vertex_normal_matrix().copy())
+
+
+def read_mesh(path: Union[str, Path]) -> Tuple[np.ndarray, np.ndarray]:
+    """(vertices (m, 3), faces (f, 3)) of a triangle mesh file pymeshlab reads (a ground truth)."""
+    path = Path(path)
+    ms = _load(path)  # held: the mesh lives inside the MeshSet
+    vertices, faces = mesh_arrays(ms.current_mesh())
+    if len(faces) == 0:
+        raise ValueError(f"{path}: the ground truth has no faces")
+    return vertices, faces
+
+
+def add_layer(ms: pymeshlab.MeshSet, cloud: Cloud, name: str = "points") -> None:
+    """Adds the cloud to `ms` as a new current layer called `name`."""
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=cloud.points, v_normals_matrix=cloud.normals), name)
