@@ -622,7 +622,7 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 		"filled (loops under %d edges); %zu unsupported faces trimmed off the boundary, %zu "
 		"boundary vertices fitted to the samples' edge.",
 		out->cm.fn, out->cm.vn, int(r.loops.size()), qUtf8Printable(loopSummary(r.loops)),
-		r.holes_filled, p.min_boundary_edges, r.faces_trimmed, r.boundary_vertices_fitted);
+		r.boundary.holes_filled, p.min_boundary_edges, r.boundary.faces_trimmed, r.boundary.boundary_vertices_fitted);
 	if (r.faces_not_manifold > 0 || r.vertices_split > 0)
 		log("Made the surface a 2-manifold: removed %zu faces from edges shared by more than two faces, split %zu "
 			"vertices where separate fans met.", r.faces_not_manifold, r.vertices_split);
@@ -632,7 +632,7 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 		log("The normals flip between neighbouring samples at %zu places (a one-sided surface, or a region "
 			"oriented inside out): cut the surface there (%zu faces) into a boundary. If that region should "
 			"not be cut, estimate normals facing the scanner's viewpoint.",
-			r.seam_points, r.faces_cut_at_seams);
+			r.seam_points, r.boundary.faces_cut_at_seams);
 	log("%s extraction: %zu SODS cells, %zu hole cells%s; %zu implicit evaluations (the full "
 		"lattice has %.0f corners, the cells the surface crosses %zu).",
 		qUtf8Printable(kExtractions[int(p.extraction)]), r.sods_cells, r.hole_cells,
@@ -645,17 +645,17 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 	res["boundary_loop_lengths"] = QVariant::fromValue(toVector(lengths));
 	res["boundary_loop_vertices"] = QVariant::fromValue(toVector(loopVertices));
 	res["boundary_loops_before_filling"] = QVariant::fromValue(toVector(
-		std::vector<double>(r.loops_before_filling.begin(), r.loops_before_filling.end())));
-	res["holes_filled"] = r.holes_filled;
+		std::vector<double>(r.boundary.loops_before_filling.begin(), r.boundary.loops_before_filling.end())));
+	res["holes_filled"] = r.boundary.holes_filled;
 	res["hole_faces"] = holes.fn;
 	res["hole_cells"] = double(r.hole_cells);
-	res["faces_trimmed"] = double(r.faces_trimmed);
-	res["boundary_vertices_fitted"] = double(r.boundary_vertices_fitted);
+	res["faces_trimmed"] = double(r.boundary.faces_trimmed);
+	res["boundary_vertices_fitted"] = double(r.boundary.boundary_vertices_fitted);
 	res["seam_points"] = double(r.seam_points);
-	res["faces_cut_at_seams"] = double(r.faces_cut_at_seams);
+	res["faces_cut_at_seams"] = double(r.boundary.faces_cut_at_seams);
 	res["duplicates_removed"] = double(r.duplicates_removed);
 	res["outliers_removed"] = double(r.outliers.size());
-	res["faces_unsupported"] = double(r.faces_unsupported);
+	res["faces_unsupported"] = double(r.boundary.faces_unsupported);
 	res["faces_not_manifold"] = double(r.faces_not_manifold);
 	res["vertices_split"] = double(r.vertices_split);
 	res["surface_faces"] = out->cm.fn;

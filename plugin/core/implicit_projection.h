@@ -1,7 +1,8 @@
 #pragma once
 /// \file implicit_projection.h
-/// Puts moved mesh vertices back onto the zero set of an implicit function, by Newton steps
-/// along its gradient (central differences at a tenth of a cell), each step at most a cell.
+/// Puts points back onto the zero set of an implicit function: moved mesh vertices, by Newton
+/// steps along its gradient (central differences at a tenth of a cell), each step at most a
+/// cell; samples, along their normals.
 
 #include "implicit/implicit_function.h"
 #include "mesh.h"
@@ -45,6 +46,16 @@ public:
             }
         }
     }
+    /// The samples P (n×3) moved along their unit normals N (n×3) onto the zero set of f, by
+    /// one Newton step (f being close to a signed distance); n×3. A fitted function (the
+    /// PU-RBF) passes up to about a spacing away from samples at sharp or noisy spots.
+    static Points OntoZeroSet(const Points& P, const Points& N, const ImplicitFunction& f)
+    {
+        Eigen::VectorXd value(P.rows());
+        f.Eval(P, value);
+        return (P.array() - N.array().colwise() * value.array()).matrix();
+    }
 };
+
 
 } // namespace ib

@@ -4,6 +4,13 @@
 /// run that cannot fit is refused with a message instead of being killed mid-way (which, in
 /// MeshLab, loses the user's unsaved work).
 
+#include "input_check.h"
+
+#include <iomanip>
+#include <sstream>
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
 #include <unistd.h>
 
 namespace ib {
@@ -40,6 +47,40 @@ struct MemoryBudget
     static double PeakBytes(double samples, double sodsCells, double denseCorners)
     {
         return kBytesFixed + kBytesPerSample * samples + kBytesPerSodsCell * sodsCells + 8.0 * denseCorners;
+    }
+    /// Refuses, before allocating, a run at `resolution` whose estimated peak (PeakBytes over
+    /// `samples`, and `sodsCells` or, for a `dense` extraction, the lattice's `denseCorners`)
+    /// exceeds `limit` bytes: throws InputError with what to change. Returns the estimate.
+    static double Check(double samples, double sodsCells, bool dense, double denseCorners, double limit,
+                        int resolution)
+    {
+        const double bytes = PeakBytes(samples, sodsCells, dense ? denseCorners : 0);
+        if (bytes <= limit)
+            return bytes;
+        const double sampleBytes = PeakBytes(samples, 0, 0);
+        std::ostringstream msg;
+        msg.precision(2);
+        msg << std::fixed << "Resolution " << resolution << " would need about " << bytes / 1e9
+            << " GB of memory (" << std::setprecision(0) << samples << " samples, "
+            << (dense ? denseCorners : sodsCells) << (dense ? " lattice corners)" : " occupied cells)")
+            << std::setprecision(2) << ", over the limit of " << limit / 1e9 << " GB: ";
+        if (sampleBytes > limit)  // no lattice, however coarse, would fit
+            msg << "the samples alone need about " << sampleBytes / 1e9
+                << " GB; thin them out (e.g. Poisson-disk sampling) or raise the memory limit.";
+        else
+            msg << "lower the resolution (0 = automatic)" << (dense ? ", use the SODS-driven extraction" : "")
+                << " or raise the memory limit.";
+        throw InputError(msg.str());
+    }
+
+    /// Hands memory freed by the last stage back to the system. Millions of small hash map
+    /// nodes, once freed, stay in the allocator's heap and count towards the process's peak
+    /// when the next stage (or the host's copy of the result) allocates large blocks.
+    static void ReleaseFreed()
+    {
+#ifdef __GLIBC__
+        malloc_trim(0);
+#endif
     }
 };
 

@@ -104,6 +104,24 @@ public:
         return N;
     }
 
+    /// The given normals N (n×3) of the samples, scaled to unit length; rows that are zero, NaN
+    /// or infinite are estimated (FillMissing with k neighbours), their count in `filled`.
+    static Points Given(const SampleIndex& samples, const Points& N, int k, size_t& filled)
+    {
+        Points normals = N;
+        std::vector<Eigen::Index> missing;
+        for (Eigen::Index i = 0; i < N.rows(); ++i) {
+            const double length = N.row(i).norm();
+            if (std::isfinite(length) && length > 0)
+                normals.row(i) /= length;
+            else
+                missing.push_back(i);
+        }
+        FillMissing(samples, normals, missing, k);
+        filled = missing.size();
+        return normals;
+    }
+
     /// Fills the rows `missing` of the n×3 normals N whose other rows are given unit normals:
     /// each gets the normal of the plane through its k nearest samples (PCA), turned to agree
     /// with the known normals among those neighbours. A patch of missing normals fills from its

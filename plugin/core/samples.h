@@ -7,6 +7,8 @@
 
 #include <vcg/space/index/kdtree/kdtree.h>
 
+#include <vector>
+
 namespace ib {
 
 class SampleIndex
@@ -35,5 +37,24 @@ private:
     // VCG's queries are not const but touch only the caller's queue.
     mutable vcg::KdTree<double> tree_;
 };
+
+/// Per sample of `kept` (rows of an input of `rows` rows, several scans one after the other
+/// with `sizes` rows each), the index of its scan; empty for a single scan.
+inline std::vector<int> ScanOfSamples(const std::vector<Eigen::Index>& sizes, Eigen::Index rows,
+                                      const std::vector<Eigen::Index>& kept)
+{
+    if (sizes.size() <= 1)
+        return {};
+    std::vector<int> scanOfRow(size_t(rows), 0);
+    Eigen::Index row = 0;
+    for (size_t s = 0; s < sizes.size(); ++s)
+        for (Eigen::Index i = 0; i < sizes[s] && row < rows; ++i)
+            scanOfRow[size_t(row++)] = int(s);
+    std::vector<int> scan;
+    scan.reserve(kept.size());
+    for (Eigen::Index i : kept)
+        scan.push_back(scanOfRow[size_t(i)]);
+    return scan;
+}
 
 } // namespace ib

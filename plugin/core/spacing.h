@@ -39,6 +39,30 @@ public:
         std::nth_element(spacing.data(), spacing.data() + spacing.size() / 2, spacing.data() + spacing.size());
         return spacing[spacing.size() / 2];
     }
+
+    /// Local sample spacing, measured among the samples of each sample's own scan (`scan`: the
+    /// scan index per sample, empty for one scan). The samples of a scan too small to measure
+    /// get the spacing among all samples.
+    static Eigen::VectorXd PerScan(const SampleIndex& samples, const std::vector<int>& scan, int threads)
+    {
+        if (scan.empty())
+            return Local(samples, 1, threads);
+        std::vector<std::vector<Eigen::Index>> rows(size_t(*std::max_element(scan.begin(), scan.end()) + 1));
+        for (size_t i = 0; i < scan.size(); ++i)
+            rows[size_t(scan[i])].push_back(Eigen::Index(i));
+        Eigen::VectorXd spacing(samples.Size());
+        std::vector<Eigen::Index> unmeasured;
+        for (const std::vector<Eigen::Index>& own : rows) {
+            if (own.size() <= size_t(kNeighbours)) {
+                unmeasured.insert(unmeasured.end(), own.begin(), own.end());
+                continue;
+            }
+            spacing(own) = Local(SampleIndex(samples.P()(own, Eigen::all)), 1, threads);
+        }
+        if (!unmeasured.empty())
+            spacing(unmeasured) = Local(samples, 1, threads)(unmeasured);
+        return spacing;
+    }
 };
 
 } // namespace ib

@@ -66,7 +66,7 @@ TEST(BoundarySteps, FlatScanIsTrimmedToItsBorderAndSmoothed)
     // boundary is within a cell of the square's border and, smoothed, about as long as it (4).
     EXPECT_GT(error0, 1.5 * r0.cell_size);
     EXPECT_LT(error1, r1.cell_size);
-    EXPECT_GT(r1.faces_trimmed, 0u);
+    EXPECT_GT(r1.boundary.faces_trimmed, 0u);
     EXPECT_NEAR(length1, 4.0, 0.4);
     EXPECT_GT(length0, length1);
     const auto t = test::Check(m1);
@@ -100,7 +100,7 @@ TEST(BoundarySteps, FlippedNormalsAreCutAlongTheFlip)
     CoreMesh m;
     const auto r = Reconstruction::Compute(P, N, Reconstruction::Param(), m);
     EXPECT_EQ(r.seam_points, size_t(seam.rows()));
-    EXPECT_GT(r.faces_cut_at_seams, 0u);
+    EXPECT_GT(r.boundary.faces_cut_at_seams, 0u);
     ASSERT_EQ(r.loops.size(), 2u);
     for (const auto& v : m.vert)  // nothing left within a spacing of the seam
         EXPECT_GT(std::abs(v.cP()[0] - 0.5), 0.02);
@@ -211,7 +211,7 @@ TEST(BoundarySteps, AGapIsFilledByAPatchNotByABalloon)
         // Flat: the gap is closed by the plane across it. Ballooned: the implicit surface
         // across the gap is the tube and the ball (up to 0.5 high); the gap stays a hole.
         EXPECT_EQ(r.loops.size(), balloon ? 2u : 1u) << (balloon ? "ballooned" : "flat");
-        EXPECT_EQ(r.holes_filled, balloon ? 0 : 1);
+        EXPECT_EQ(r.boundary.holes_filled, balloon ? 0 : 1);
         EXPECT_LT(highest, 2 * r.cell_size) << (balloon ? "ballooned" : "flat");
         const auto t = test::Check(m);
         EXPECT_EQ(t.non_manifold_edges, 0);

@@ -53,7 +53,7 @@ TEST(Reconstruction, HemisphereHasExactlyOneBoundaryLoopAtItsRim)
         sum += d;
     }
     EXPECT_LT(sum / r.loops[0].Edges(), r.cell_size / 3);
-    EXPECT_GT(r.faces_trimmed, 0u);
+    EXPECT_GT(r.boundary.faces_trimmed, 0u);
     EXPECT_NEAR(r.loops[0].length, 2 * M_PI, 0.15 * 2 * M_PI);  // smoothed: 1.8 times as long unsmoothed
     const auto t = test::Check(m);
     EXPECT_EQ(t.non_manifold_edges, 0);
