@@ -20,19 +20,20 @@ import implicit_boundaries
 from implicit_boundaries import poisson_with_boundaries
 from implicit_boundaries.methods import density_trim, poisson_depth
 from implicit_boundaries.metrics import boundary_curves, boundary_distance, boundary_vertex_sets, loops_found
+from implicit_boundaries.options import Implicit, SodsOccupancy
 
 DEFAULT_DATA = Path(__file__).resolve().parent.parent.parent / "shared" / "data"
 CASES = ["bun_zipper.ply", "mech-holes-shark.off", "fandisk_truncated.off", "tum_rabbit.ply", "gargoyle.ply"]
 METHODS = {
     "ours (defaults)": {},
-    "ours, Hoppe's distance": {"implicit": "Hoppe signed distance"},
+    "ours, Hoppe's distance": {"implicit": Implicit.HOPPE},
     "ours, no smoothing": {"boundary_smoothing": 0},
     "ours, no trim": {"boundary_trim": 0.0},
     "ours, no trim, no smoothing": {"boundary_trim": 0.0, "boundary_smoothing": 0},
     "ours, no fit": {"boundary_fit": False},
     "ours, no fit, no smoothing": {"boundary_fit": False, "boundary_smoothing": 0},
     "ours, min_boundary_edges 0": {"min_boundary_edges": 0},
-    "paper SODS (cells + 1 ring), smoothing 4": {"sods_occupancy": "Sample cells (paper)", "sods_dilation": 1,
+    "paper SODS (cells + 1 ring), smoothing 4": {"sods_occupancy": SodsOccupancy.SAMPLE_CELLS, "sods_dilation": 1,
                                                  "boundary_trim": 0.0},
 }
 
@@ -109,7 +110,7 @@ def references(args):
                            "Hoppe + our boundaries", "ball pivoting"]:
                 if method == "Hoppe + our boundaries":
                     hoppe, _, found, spurious, distance = run(points, normals, truth, truth_curves, 0,
-                                                              {"implicit": "Hoppe signed distance"})
+                                                              {"implicit": Implicit.HOPPE})
                     rows.append((method, hoppe["boundary_loops"], found, spurious, distance))
                     continue
                 loops, found_curves, _ = reference_loops(method, points, normals, ours["resolution"])

@@ -21,10 +21,11 @@ import numpy as np
 import pymeshlab
 
 import implicit_boundaries
+from implicit_boundaries.options import Extraction, Implicit
 from boundaries import load_case
 
 DEFAULT_DATA = Path(__file__).resolve().parent.parent.parent / "shared" / "data"
-MODES = ["SODS-driven", "Full lattice, gated", "Plain marching cubes"]
+MODES = list(Extraction.LABELS)
 
 
 def synthetic_scan(n=1_000_000, seed=0):
@@ -90,7 +91,7 @@ def main(argv=None):
     p.add_argument("--modes", nargs="+", choices=MODES, default=MODES,
                    help="extraction modes to run (the full lattice on the synthetic sphere is slow: its "
                         "centre is the k-d tree's worst case)")
-    p.add_argument("--implicit", default="PU-RBF (paper)", help="the filter's implicit function (default: its default)")
+    p.add_argument("--implicit", default=Implicit.PU_RBF, help="the filter's implicit function (default: its default)")
     p.add_argument("--large", action="store_true",
                    help="only a synthetic 5,000,000-sample scan at the default (automatic) resolution")
     p.add_argument("--one", nargs=3, metavar=("CASE", "RESOLUTION", "MODE"), help=argparse.SUPPRESS)
@@ -101,7 +102,7 @@ def main(argv=None):
         print(json.dumps(one(case, args.data, int(resolution), mode, args.implicit)))
         return
     if args.large:
-        r = child("synthetic 5M", args.data, 0, "SODS-driven", args.implicit)
+        r = child("synthetic 5M", args.data, 0, Extraction.SODS_DRIVEN, args.implicit)
         print("| samples | resolution | time (s) | implicit / SODS / extraction / boundaries (s) | peak memory (GB) "
               "| memory limit (GB) | SODS cells | faces | loops |\n|---|---|---|---|---|---|---|---|---|")
         print(f"| 5,000,000 | {r['resolution']:.0f} (automatic) | {r['seconds']:.1f} | {r['seconds_implicit']:.1f} / "
@@ -117,20 +118,20 @@ def main(argv=None):
         for resolution in args.resolutions:
             rows = {mode: child(case, args.data, resolution, mode, args.implicit) for mode in args.modes}
             missing = {"error": "not run"}
-            full, plain = rows.get("Full lattice, gated", missing), rows.get("Plain marching cubes", missing)
+            full, plain = rows.get(Extraction.FULL_LATTICE, missing), rows.get(Extraction.PLAIN, missing)
             for mode, r in rows.items():
                 if "error" in r:
                     print(f"| {case} | {resolution} | {mode} | {r['error']} |||||||")
                     continue
                 vs_full = f"{r['seconds'] / full['seconds']:.3f}" if "error" not in full else ""
                 vs_plain = (f"{full['seconds_extraction'] / plain['seconds_extraction']:.3f}"
-                            if mode == "Full lattice, gated" and "error" not in plain else "")
+                            if mode == Extraction.FULL_LATTICE and "error" not in plain else "")
                 print(f"| {case} | {resolution} | {mode} | {r['implicit_evaluations']:.0f} "
                       f"| {r['implicit_evaluations'] / r['crossed_cell_corners']:.2f} | {r['seconds']:.2f} "
                       f"| {r['seconds_extraction']:.2f} "
                       f"| {r['peak_mb']:.0f} (input {r['before_mb']:.0f}) | {r['surface_faces']:.0f} "
                       f"| {r['boundary_loops']:.0f} | {vs_full} | {vs_plain} |", flush=True)
-    r = child("synthetic 1M", args.data, 1024, "SODS-driven", args.implicit)
+    r = child("synthetic 1M", args.data, 1024, Extraction.SODS_DRIVEN, args.implicit)
     print(f"\nSODS-driven at 1024 on the synthetic 1M scan: {r}")
 
 

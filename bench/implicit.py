@@ -30,22 +30,23 @@ import implicit_boundaries
 from boundaries import load_case
 from extraction import synthetic_scan
 from implicit_boundaries.methods import poisson_depth
+from implicit_boundaries.options import Implicit
 from implicit_boundaries.metrics import point_mesh_distance, sample_surface
 
 DEFAULT_DATA = Path(__file__).resolve().parent.parent.parent / "shared" / "data"
 # Our filter's parameters per method ("screened Poisson" is MeshLab's filter).
 METHODS = {
-    "PU-RBF (paper)": {"implicit": "PU-RBF (paper)"},
-    "PU-RBF, fits of 20-60 samples": {"implicit": "PU-RBF (paper)", "rbf_min_samples": 20, "rbf_max_samples": 60,
+    Implicit.PU_RBF: {"implicit": Implicit.PU_RBF},
+    "PU-RBF, fits of 20-60 samples": {"implicit": Implicit.PU_RBF, "rbf_min_samples": 20, "rbf_max_samples": 60,
                                       "rbf_off_surface": 0.5},
-    "Hoppe signed distance": {"implicit": "Hoppe signed distance"},
+    Implicit.HOPPE: {"implicit": Implicit.HOPPE},
     "screened Poisson": None,
     # Variants of the paper's 50-160 samples per cell, run with --methods.
-    "PU-RBF, off-surface 0.5": {"implicit": "PU-RBF (paper)", "rbf_off_surface": 0.5},
-    "PU-RBF, overlap 1.2": {"implicit": "PU-RBF (paper)", "rbf_overlap": 1.2},
-    "PU-RBF, overlap 1.2, off-surface 0.5": {"implicit": "PU-RBF (paper)", "rbf_overlap": 1.2, "rbf_off_surface": 0.5},
+    "PU-RBF, off-surface 0.5": {"implicit": Implicit.PU_RBF, "rbf_off_surface": 0.5},
+    "PU-RBF, overlap 1.2": {"implicit": Implicit.PU_RBF, "rbf_overlap": 1.2},
+    "PU-RBF, overlap 1.2, off-surface 0.5": {"implicit": Implicit.PU_RBF, "rbf_overlap": 1.2, "rbf_off_surface": 0.5},
 }
-DEFAULT_METHODS = ["PU-RBF (paper)", "PU-RBF, fits of 20-60 samples", "Hoppe signed distance", "screened Poisson"]
+DEFAULT_METHODS = [Implicit.PU_RBF, "PU-RBF, fits of 20-60 samples", Implicit.HOPPE, "screened Poisson"]
 
 
 def surface_distances(vertices, faces, truth_vertices, truth_faces, samples=20000):

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 import implicit_boundaries
+from implicit_boundaries.options import Implicit
 from scipy.spatial import cKDTree
 
 from shapes import (check_oriented_manifold, cylinder, fibonacci_sphere, moebius, sphere_circle, torus,
@@ -90,7 +91,7 @@ SHAPES = {
     # Its rim is sampled more densely than its surface; the PU-RBF's boundary there once came out
     # 1.2 cells inside the cut, where the fit's edge line ran through a sample inside the rim.
     "plane-cut torus": (cut_torus, 2, {}),
-    "plane-cut torus, Hoppe": (cut_torus, 2, {"implicit": "Hoppe signed distance"}),
+    "plane-cut torus, Hoppe": (cut_torus, 2, {"implicit": Implicit.HOPPE}),
     "two disjoint patches": (polar_caps, 2, {}),
     "sphere with 5 holes and 3 gaps": (punched_sphere_case, 5, {"min_boundary_edges": 25}),
 }
@@ -189,7 +190,7 @@ def euler_characteristic(faces):
     return len(np.unique(faces)) - len(edges) + len(faces)
 
 
-@pytest.mark.parametrize("implicit", ["PU-RBF (paper)", "Hoppe signed distance"])
+@pytest.mark.parametrize("implicit", [Implicit.PU_RBF, Implicit.HOPPE])
 def test_moebius_strip_has_one_loop_and_one_seam(implicit):
     """A signed implicit function cannot represent a one-sided surface: the estimated normals
     must flip somewhere, and the surface is cut there across the strip. What remains is one
@@ -219,7 +220,7 @@ def test_moebius_strip_has_one_loop_and_one_seam(implicit):
     check_oriented_manifold(rec.vertices, rec.faces)
 
 
-@pytest.mark.parametrize("implicit", ["PU-RBF (paper)", "Hoppe signed distance"])
+@pytest.mark.parametrize("implicit", [Implicit.PU_RBF, Implicit.HOPPE])
 def test_a_region_with_flipped_normals_comes_out_inside_out_behind_a_seam(implicit):
     """An orientation failure: the normals of a cap of a closed sphere point inwards (what
     propagation does when it crosses a thin or sparse part). The cap comes out inside out

@@ -10,9 +10,10 @@ import pymeshlab
 import pytest
 
 import implicit_boundaries
+from implicit_boundaries.options import Implicit, Normals
 from shapes import fibonacci_sphere
 
-IMPLICITS = ["Hoppe signed distance", "PU-RBF (paper)"]
+IMPLICITS = [Implicit.HOPPE, Implicit.PU_RBF]
 
 
 def open_sphere():
@@ -29,7 +30,7 @@ def run(implicit, estimate):
     points, normals = open_sphere()
     ms = pymeshlab.MeshSet()
     ms.add_mesh(pymeshlab.Mesh(vertex_matrix=points, v_normals_matrix=normals), "sphere")
-    result = implicit_boundaries.apply(ms, implicit=implicit, normals="Estimate" if estimate else "Use layer normals")
+    result = implicit_boundaries.apply(ms, implicit=implicit, normals=Normals.ESTIMATE if estimate else Normals.USE_LAYER)
     out = ms.current_mesh()
     return (out.vertex_matrix().copy(), out.face_matrix().copy(),
             np.asarray(result["boundary_loop_vertices"]).copy())

@@ -22,6 +22,7 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, event, given, settings, strategies as st
 
+from implicit_boundaries.options import Extraction, Implicit, Normals, SodsOccupancy
 from shapes import check_oriented_manifold
 
 PROFILE = os.environ.get("IB_FUZZ_PROFILE", "default")
@@ -270,15 +271,15 @@ def clouds(draw, max_points=MAX_POINTS):
 def parameters(draw, max_resolution=MAX_RESOLUTION):
     return {
         "resolution": draw(st.one_of(st.just(0), st.integers(8, max_resolution))),
-        "implicit": draw(st.sampled_from(["Hoppe signed distance", "PU-RBF (paper)"])),
-        "sods_occupancy": draw(st.sampled_from(["Tangent disks", "Sample cells (paper)"])),
+        "implicit": draw(st.sampled_from([Implicit.HOPPE, Implicit.PU_RBF])),
+        "sods_occupancy": draw(st.sampled_from(SodsOccupancy.LABELS)),
         "sods_dilation": draw(st.integers(0, 2)),
         "sample_radius": draw(st.floats(0.25, 8.0)),
         "min_boundary_edges": draw(st.integers(0, 40)),
         "boundary_smoothing": draw(st.integers(0, 8)),
         "boundary_trim": draw(st.floats(0.0, 8.0)),
-        "extraction": draw(st.sampled_from(["SODS-driven", "Full lattice, gated", "Plain marching cubes"])),
-        "normals": draw(st.sampled_from(["Use layer normals", "Estimate"])),
+        "extraction": draw(st.sampled_from(Extraction.LABELS)),
+        "normals": draw(st.sampled_from([Normals.USE_LAYER, Normals.ESTIMATE])),
         "hole_layer": draw(st.booleans()),
         # Bounded so that outputs stay small enough to check here: under the default (half the
         # RAM) a plain marching cubes run over noise returns tens of millions of faces, and
@@ -414,9 +415,9 @@ REFUSED = {
     "rbf_max_samples 7": (flat_scan, dict(rbf_max_samples=7), "maximum samples per cell must be between 8 and 5000"),
     "rbf_overlap 0.5": (flat_scan, dict(rbf_overlap=0.5), "overlap must be between 1"),
     "rbf_off_surface 0": (flat_scan, dict(rbf_off_surface=0.0), "off-surface distance must be above 0"),
-    "mesh layer without faces": (flat_scan, dict(implicit="Mesh layer (signed distance)", implicit_mesh=0),
+    "mesh layer without faces": (flat_scan, dict(implicit=Implicit.MESH_LAYER, implicit_mesh=0),
                                  "has no faces"),
-    "mesh layer of degenerate faces": (flat_scan, dict(implicit="Mesh layer (signed distance)", implicit_mesh=1),
+    "mesh layer of degenerate faces": (flat_scan, dict(implicit=Implicit.MESH_LAYER, implicit_mesh=1),
                                        "only degenerate (zero-area) faces"),
 }
 MESH_LAYERS = {"mesh layer of degenerate faces": (np.zeros((3, 3)), np.array([[0, 1, 2]], dtype=np.int32))}
@@ -438,7 +439,7 @@ ACCEPTED = {  # the issue's odd but valid inputs: a surface comes out
     "unit scan far from the origin (1e6)": (lambda: flat_scan(offset=1e6), {}),
     "every sample three times": (lambda: tuple(np.tile(a, (3, 1)) for a in flat_scan()), {}),
     "all normals zero (estimated)": (lambda: (flat_scan()[0], np.zeros((600, 3))), {}),
-    "flat scan, PU-RBF": (flat_scan, dict(implicit="PU-RBF (paper)")),
+    "flat scan, PU-RBF": (flat_scan, dict(implicit=Implicit.PU_RBF)),
 }
 
 
@@ -458,15 +459,15 @@ def test_odd_but_valid_inputs_give_a_surface(worker, name):
 # What the fuzzing found, kept as regressions: (recipe, parameters, what must come out).
 
 # The parameters the fuzzer ran with when it found these (not the filter's defaults).
-FOUND_WITH = {"resolution": 0, "implicit": "Hoppe signed distance", "sods_occupancy": "Tangent disks",
+FOUND_WITH = {"resolution": 0, "implicit": Implicit.HOPPE, "sods_occupancy": SodsOccupancy.TANGENT_DISKS,
                   "sods_dilation": 0, "sample_radius": 1.0, "min_boundary_edges": 12, "boundary_smoothing": 0,
-                  "boundary_trim": 0.5, "extraction": "SODS-driven", "normals": "Use layer normals",
+                  "boundary_trim": 0.5, "extraction": Extraction.SODS_DRIVEN, "normals": Normals.USE_LAYER,
                   "hole_layer": False}
 SMALL_CLUSTER = {"n": 10, "shapes": ["cluster"], "scale": 1.0, "offset": 0.0, "duplicates": 0, "nans": 0,
                  "normals": "none", "seed": 0}
 THREE_CLUSTERS = {**SMALL_CLUSTER, "n": 1455, "shapes": ["cluster"] * 3, "seed": 1116}
-PLAIN_OVER_CLUSTERS = dict(sods_occupancy="Sample cells (paper)", sods_dilation=1, min_boundary_edges=0,
-                           boundary_trim=1.0, extraction="Plain marching cubes", normals="Estimate")
+PLAIN_OVER_CLUSTERS = dict(sods_occupancy=SodsOccupancy.SAMPLE_CELLS, sods_dilation=1, min_boundary_edges=0,
+                           boundary_trim=1.0, extraction=Extraction.PLAIN, normals=Normals.ESTIMATE)
 FOUND = {
     # 10 scattered samples: every face was trimmed or filled away and an empty layer was added
     "empty surface": (SMALL_CLUSTER, dict(min_boundary_edges=28), "No surface was extracted"),
@@ -482,7 +483,7 @@ FOUND = {
     # A hole fan touching the surface only at a vertex, across an opening of the extraction: each
     # layer a 2-manifold, welded a bow-tie (found after 1,711 examples of `make fuzz`)
     "holes layer bow-tie with the surface": ({**SMALL_CLUSTER, "n": 2402},
-                                             dict(sods_occupancy="Sample cells (paper)", min_boundary_edges=0,
+                                             dict(sods_occupancy=SodsOccupancy.SAMPLE_CELLS, min_boundary_edges=0,
                                                   boundary_trim=0.0, hole_layer=True), None),
 }
 

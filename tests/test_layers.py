@@ -6,6 +6,7 @@ import pymeshlab
 import pytest
 
 import implicit_boundaries
+from implicit_boundaries.options import Normals
 from shapes import fibonacci_sphere
 
 
@@ -268,14 +269,14 @@ def test_estimated_normals_face_each_scans_camera(plugin, tmp_path):
     ms.load_new_mesh(str(tmp_path / "upper.ply"))
     ms.load_new_mesh(str(tmp_path / "lower.ply"))
     ms.set_matrix(transformmatrix=matrix, freeze=False)
-    out = implicit_boundaries.apply(ms, merge_visible_layers=True, normals="Estimate")
+    out = implicit_boundaries.apply(ms, merge_visible_layers=True, normals=Normals.ESTIMATE)
     assert out["normals_estimated"] and out["boundary_loops"] == 0
     assert inward_fraction(ms.current_mesh()) > 0.99
     # Without cameras (the same points in plain layers): outward.
     plain = pymeshlab.MeshSet()
     plain.add_mesh(pymeshlab.Mesh(vertex_matrix=upper))
     plain.add_mesh(pymeshlab.Mesh(vertex_matrix=lower))
-    implicit_boundaries.apply(plain, merge_visible_layers=True, normals="Estimate")
+    implicit_boundaries.apply(plain, merge_visible_layers=True, normals=Normals.ESTIMATE)
     assert inward_fraction(plain.current_mesh()) < 0.01
 
 
@@ -291,7 +292,7 @@ def test_estimated_normals_follow_the_range_grids_triangles(plugin):
     vertices = hull.current_mesh().vertex_matrix()
     ms = pymeshlab.MeshSet()
     ms.add_mesh(pymeshlab.Mesh(vertex_matrix=vertices, face_matrix=faces), "range grid")
-    implicit_boundaries.apply(ms, normals="Estimate")
+    implicit_boundaries.apply(ms, normals=Normals.ESTIMATE)
     assert inward_fraction(ms.current_mesh()) > 0.99
     # The same grid placed by a matrix (turned, stretched, moved): the triangles still decide.
     matrix = np.eye(4)
@@ -300,14 +301,14 @@ def test_estimated_normals_follow_the_range_grids_triangles(plugin):
     ms = pymeshlab.MeshSet()
     ms.add_mesh(pymeshlab.Mesh(vertex_matrix=vertices, face_matrix=faces), "range grid")
     ms.set_matrix(transformmatrix=matrix, freeze=False)
-    implicit_boundaries.apply(ms, normals="Estimate")
+    implicit_boundaries.apply(ms, normals=Normals.ESTIMATE)
     moved = ms.current_mesh()
     v, f = moved.vertex_matrix() - matrix[:3, 3], moved.face_matrix()
     normal = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
     assert (np.sum(normal * v[f].mean(axis=1), axis=1) < 0).mean() > 0.99
     ms = pymeshlab.MeshSet()
     ms.add_mesh(pymeshlab.Mesh(vertex_matrix=vertices), "points")
-    implicit_boundaries.apply(ms, normals="Estimate")
+    implicit_boundaries.apply(ms, normals=Normals.ESTIMATE)
     assert inward_fraction(ms.current_mesh()) < 0.01
 
 

@@ -8,6 +8,7 @@ import implicit_boundaries
 from conftest import SAMPLES, point_cloud
 from shapes import fibonacci_sphere
 from implicit_boundaries.metrics import boundary_vertex_sets, match_loops
+from implicit_boundaries.options import Extraction, Implicit, SodsOccupancy
 
 FILTER = implicit_boundaries.FILTER_NAME
 
@@ -78,7 +79,7 @@ def test_bunny_scan_keeps_its_real_holes(plugin):
     assert result["seam_points"] == 0
 
 
-@pytest.mark.parametrize("implicit", ["PU-RBF (paper)", "Hoppe signed distance"])
+@pytest.mark.parametrize("implicit", [Implicit.PU_RBF, Implicit.HOPPE])
 def test_implicit_is_chosen_by_name(plugin, implicit):
     """Both implicit functions by name on the bunny: the result says which ran (and the PU-RBF's
     local fits), 3 real holes come out as loops at their place (not the same 3: Hoppe's third is
@@ -87,7 +88,7 @@ def test_implicit_is_chosen_by_name(plugin, implicit):
     loop appears anywhere else (the PU-RBF's regularisation was 1e-6 here once: its zero set
     bulged past the rim of an ear and left a spurious loop there)."""
     result, found, spurious = bunny_holes(implicit=implicit)
-    rbf = implicit == "PU-RBF (paper)"
+    rbf = implicit == Implicit.PU_RBF
     assert result["implicit"] == (0 if rbf else 1)
     assert (result["rbf_cells"] > 10) == rbf and result["rbf_cells"] >= 0
     assert not spurious, f"loops of {spurious} edges far from every real hole"
@@ -201,7 +202,8 @@ def test_paper_occupancy_is_selectable(plugin):
     the dilation it leaves the closed bunny full of holes, with one ring it closes it."""
     points, normals, _ = point_cloud(SAMPLES / "bunny.obj")
     runs = {}
-    for occupancy, dilation in [("Tangent disks", 0), ("Sample cells (paper)", 0), ("Sample cells (paper)", 1)]:
+    disks, cells = SodsOccupancy.TANGENT_DISKS, SodsOccupancy.SAMPLE_CELLS
+    for occupancy, dilation in [(disks, 0), (cells, 0), (cells, 1)]:
         ms = new_set(points, normals)
         try:
             runs[occupancy, dilation] = getattr(ms, FILTER)(sods_occupancy=occupancy, sods_dilation=dilation, resolution=100)
@@ -209,11 +211,11 @@ def test_paper_occupancy_is_selectable(plugin):
             raise AssertionError((occupancy, dilation, str(e)))
     for dilation in (0, 1):
         expected, cell = paper_sods_cells(points, 100, dilation)
-        assert runs["Sample cells (paper)", dilation]["cell_size"] == pytest.approx(cell)
-        assert runs["Sample cells (paper)", dilation]["sods_cells"] == expected
-    assert runs["Tangent disks", 0]["sods_cells"] != runs["Sample cells (paper)", 1]["sods_cells"]
-    assert runs["Sample cells (paper)", 0]["boundary_loops"] > 100
-    assert runs["Sample cells (paper)", 1]["boundary_loops"] == 0 and runs["Tangent disks", 0]["boundary_loops"] == 0
+        assert runs[cells, dilation]["cell_size"] == pytest.approx(cell)
+        assert runs[cells, dilation]["sods_cells"] == expected
+    assert runs[disks, 0]["sods_cells"] != runs[cells, 1]["sods_cells"]
+    assert runs[cells, 0]["boundary_loops"] > 100
+    assert runs[cells, 1]["boundary_loops"] == 0 and runs[disks, 0]["boundary_loops"] == 0
 
 
 def test_empty_layer_raises_a_clear_error(plugin, tmp_path):
@@ -251,7 +253,7 @@ def test_bad_layers_raise_clear_errors(plugin, make, message):
     (dict(normal_neighbours=1), "neighbours"),
     (dict(memory_limit=-1.0), "memory limit"),
     (dict(resolution=1500, memory_limit=0.05), "over the limit of 0.05 GB"),
-    (dict(resolution=400, extraction="Full lattice, gated", memory_limit=0.1), "use the SODS-driven"),
+    (dict(resolution=400, extraction=Extraction.FULL_LATTICE, memory_limit=0.1), "use the SODS-driven"),
 ])
 def test_bad_parameters_raise_clear_errors(plugin, params, message):
     points, normals, _ = point_cloud(SAMPLES / "bunny10k_textured.obj")
@@ -306,7 +308,7 @@ print("loaded")
     assert child.returncode == 0 and "loaded" in child.stdout, child.stderr[-2000:]
 
 
-@pytest.mark.parametrize("extraction", ["Full lattice, gated", "Plain marching cubes"])
+@pytest.mark.parametrize("extraction", [Extraction.FULL_LATTICE, Extraction.PLAIN])
 def test_extraction_modes_by_name(plugin, extraction):
     """The full-lattice extractions evaluate every lattice corner; the gated one gives the
     SODS-driven mesh exactly, plain marching cubes the closed surface (no boundary loops)."""
@@ -318,7 +320,7 @@ def test_extraction_modes_by_name(plugin, extraction):
     full = getattr(ms, FILTER)(extraction=extraction)
     assert full["implicit_evaluations"] == full["full_lattice_evaluations"] > 5 * sparse["implicit_evaluations"]
     assert sparse["crossed_cell_corners"] <= sparse["implicit_evaluations"] <= 1.5 * sparse["crossed_cell_corners"]
-    if extraction == "Plain marching cubes":
+    if extraction == Extraction.PLAIN:
         assert full["boundary_loops"] == 0 and full["surface_faces"] > sparse["surface_faces"]
     else:
         assert np.array_equal(ms.current_mesh().vertex_matrix(), sparse_vertices)

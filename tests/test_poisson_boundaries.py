@@ -6,7 +6,8 @@ import pytest
 
 import implicit_boundaries
 from implicit_boundaries.metrics import point_mesh_distance
-from implicit_boundaries.poisson import MESH_IMPLICIT, poisson_with_boundaries
+from implicit_boundaries.options import Implicit
+from implicit_boundaries.poisson import poisson_with_boundaries
 from shapes import check_oriented_manifold, fibonacci_sphere
 
 
@@ -50,7 +51,7 @@ def test_mesh_implicit_needs_a_layer_with_faces(hemisphere):
     ms = pymeshlab.MeshSet()
     ms.add_mesh(pymeshlab.Mesh(vertex_matrix=hemisphere, v_normals_matrix=hemisphere), "hemisphere")
     with pytest.raises(pymeshlab.PyMeshLabException, match="has no faces"):
-        implicit_boundaries.apply(ms, implicit=MESH_IMPLICIT, implicit_mesh=0)
+        implicit_boundaries.apply(ms, implicit=Implicit.MESH_LAYER, implicit_mesh=0)
     assert ms.mesh_number() == 1
 
 
@@ -61,5 +62,5 @@ def test_the_mesh_implicit_defaults_to_the_layer_poisson_made(hemisphere):
     ms.add_mesh(pymeshlab.Mesh(vertex_matrix=hemisphere, v_normals_matrix=hemisphere), "hemisphere")
     ms.generate_surface_reconstruction_screened_poisson(depth=7)
     ms.set_current_mesh(0)
-    info = implicit_boundaries.apply(ms, implicit=MESH_IMPLICIT)
+    info = implicit_boundaries.apply(ms, implicit=Implicit.MESH_LAYER)
     assert info["boundary_loops"] == 1 and ms.mesh_number() == 3

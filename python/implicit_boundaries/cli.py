@@ -18,6 +18,7 @@ import pymeshlab
 from ._plugin import FILTER_NAME, PluginMismatchError, apply, describe_build, load, plugin_build, plugin_path
 from .alignment import read_alignment
 from .compare import compare
+from .options import Normals, SodsOccupancy
 from .reconstruct import loops_from_result
 
 DEMO_SCAN = Path(pymeshlab.__file__).parent / "tests" / "sample_meshes" / "bunny10k_textured.obj"
@@ -87,11 +88,11 @@ def _filter_params(args) -> dict:
               for name in ("sods_dilation", "sample_radius", "min_boundary_edges", "boundary_smoothing")
               if getattr(args, name) is not None}
     if args.paper_occupancy:
-        params["sods_occupancy"] = "Sample cells (paper)"
+        params["sods_occupancy"] = SodsOccupancy.SAMPLE_CELLS
     if args.estimate_normals:
-        params["normals"] = "Estimate"
+        params["normals"] = Normals.ESTIMATE
     if args.viewpoint is not None:
-        params["normals"] = "Estimate, facing the viewpoint"
+        params["normals"] = Normals.FACING_VIEWPOINT
         params["viewpoint"] = np.array(args.viewpoint, dtype=np.float64)
     return params
 

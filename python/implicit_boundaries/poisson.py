@@ -6,9 +6,8 @@ import numpy as np
 import pymeshlab
 
 from ._plugin import apply, load
+from .options import Implicit
 from .reconstruct import Reconstruction, loops_from_result
-
-MESH_IMPLICIT = "Mesh layer (signed distance)"
 
 
 def poisson_with_boundaries(source: Union[pymeshlab.MeshSet, np.ndarray], normals: Optional[np.ndarray] = None, *,
@@ -38,7 +37,7 @@ def poisson_with_boundaries(source: Union[pymeshlab.MeshSet, np.ndarray], normal
     ms.generate_surface_reconstruction_screened_poisson(depth=depth, threads=poisson_threads)
     poisson_id = ms.current_mesh_id()
     ms.set_current_mesh(points_id)
-    info = apply(ms, implicit=MESH_IMPLICIT, implicit_mesh=poisson_id, **params)
+    info = apply(ms, implicit=Implicit.MESH_LAYER, implicit_mesh=poisson_id, **params)
     if isinstance(source, pymeshlab.MeshSet):
         return info
     out = ms.current_mesh()

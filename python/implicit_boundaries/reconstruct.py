@@ -6,9 +6,7 @@ import numpy as np
 import pymeshlab
 
 from ._plugin import apply, load
-
-NORMALS = {False: "Use layer normals", True: "Estimate"}
-FACING_VIEWPOINT = "Estimate, facing the viewpoint"
+from .options import Normals
 
 
 @dataclass
@@ -61,9 +59,9 @@ def reconstruct(points, normals: Optional[np.ndarray] = None, estimate_normals: 
     ms = pymeshlab.MeshSet()
     ms.add_mesh(mesh, "points")
     if viewpoint is not None:
-        params.update(normals=FACING_VIEWPOINT, viewpoint=np.asarray(viewpoint, dtype=np.float64).reshape(3))
+        params.update(normals=Normals.FACING_VIEWPOINT, viewpoint=np.asarray(viewpoint, dtype=np.float64).reshape(3))
     else:
-        params["normals"] = NORMALS[bool(estimate_normals)]
+        params["normals"] = Normals.ESTIMATE if estimate_normals else Normals.USE_LAYER
     info = apply(ms, **params)
     out = ms.current_mesh()
     return Reconstruction(out.vertex_matrix(), out.face_matrix(), loops_from_result(info), dict(info))
