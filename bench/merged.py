@@ -23,8 +23,7 @@ import pymeshlab
 import implicit_boundaries
 from implicit_boundaries import metrics
 from implicit_boundaries.alignment import read_alignment
-from implicit_boundaries.cli import _point_cloud
-from implicit_boundaries.cloud import Cloud, mesh_arrays
+from implicit_boundaries.cloud import Cloud, add_layer, mesh_arrays, read_cloud
 from implicit_boundaries.methods import Surface, density_trim, poisson_depth
 from implicit_boundaries.table import format_value
 
@@ -33,10 +32,10 @@ from corpus import DEFAULT_DATA, parse_params  # noqa: E402
 
 
 def scan_layers(alignment: Path) -> pymeshlab.MeshSet:
-    """One layer per scan, with its matrix."""
+    """One layer per scan, with its matrix; missing normals left for the filter to estimate."""
     ms = pymeshlab.MeshSet()
     for path, matrix in read_alignment(alignment):
-        _point_cloud(ms, path, matrix)
+        add_layer(ms, read_cloud(path, estimate_normals=False), path.stem, matrix)
     return ms
 
 

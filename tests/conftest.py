@@ -5,6 +5,7 @@ import pymeshlab
 import pytest
 
 import implicit_boundaries
+from implicit_boundaries.cloud import read_cloud
 
 SAMPLES = Path(pymeshlab.__file__).parent / "tests" / "sample_meshes"
 
@@ -15,9 +16,6 @@ def plugin():
 
 
 def point_cloud(path):
-    """Vertices and normals of a mesh file (faces dropped), as MeshLab computes them on load."""
-    ms = pymeshlab.MeshSet()
-    ms.load_new_mesh(str(path))
-    m = ms.current_mesh()
-    m.compact()
-    return m.vertex_matrix().copy(), m.vertex_normal_matrix().copy(), m.face_matrix().copy()
+    """(points (n, 3), normals (n, 3)) of a mesh file, faces dropped, by the package's loader."""
+    cloud = read_cloud(path)
+    return cloud.points, cloud.normals

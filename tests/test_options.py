@@ -5,7 +5,7 @@ import pymeshlab
 import pytest
 
 import implicit_boundaries
-from implicit_boundaries.options import ENUMS
+from implicit_boundaries.options import ENUMS, NORMAL_NEIGHBOURS
 from shapes import fibonacci_sphere
 
 
@@ -40,8 +40,9 @@ def test_the_labels_match_the_plugin_in_order(plugin_enums, parameter):
     assert sorted(named) == sorted(labels.LABELS)  # no label left out of LABELS
 
 
-def test_the_first_label_is_the_default(plugin):
+def test_the_first_label_and_the_normal_neighbours_are_the_defaults(plugin):
     ms = pymeshlab.MeshSet()
     ms.add_mesh(pymeshlab.Mesh(vertex_matrix=fibonacci_sphere(50)))
     defaults = ms.filter_parameter_values(implicit_boundaries.FILTER_NAME)  # an enum's default as its index
     assert {name: defaults[name] for name in ENUMS} == {name: 0 for name in ENUMS}
+    assert defaults["normal_neighbours"] == NORMAL_NEIGHBOURS

@@ -7,6 +7,7 @@ from scipy.spatial import cKDTree
 import implicit_boundaries
 from conftest import SAMPLES, point_cloud
 from shapes import fibonacci_sphere
+from implicit_boundaries.cloud import read_mesh
 from implicit_boundaries.metrics import boundary_vertex_sets, match_loops
 from implicit_boundaries.options import Extraction, Implicit, SodsOccupancy
 
@@ -30,7 +31,7 @@ def test_plugin_loads_and_binds_the_method(plugin):
 
 
 def test_filter_makes_a_new_current_layer_with_loops_selected(plugin):
-    points, normals, _ = point_cloud(SAMPLES / "bunny10k_textured.obj")
+    points, normals = point_cloud(SAMPLES / "bunny10k_textured.obj")
     ms = new_set(points, normals)
     result = getattr(ms, FILTER)()
     assert ms.mesh_number() == 2 and ms.current_mesh_id() == 1
@@ -51,7 +52,8 @@ def bunny_holes(**params):
     """The filter on pymeshlab's bunny (5,051 vertices, 5 holes at its base): its result, the
     edge counts of the loops found at each true hole {hole: [edges]}, and those of the loops far
     from every true hole."""
-    points, normals, faces = point_cloud(SAMPLES / "bunny10k_textured.obj")
+    points, normals = point_cloud(SAMPLES / "bunny10k_textured.obj")
+    _, faces = read_mesh(SAMPLES / "bunny10k_textured.obj")  # the same vertices, in the same order
     true_holes = boundary_vertex_sets(faces, len(points))
     assert len(true_holes) == 5
     ms = new_set(points, normals)
@@ -96,7 +98,7 @@ def test_implicit_is_chosen_by_name(plugin, implicit):
 
 
 def test_small_holes_are_filled_only_below_the_threshold(plugin):
-    points, normals, _ = point_cloud(SAMPLES / "bunny10k_textured.obj")
+    points, normals = point_cloud(SAMPLES / "bunny10k_textured.obj")
     ms = new_set(points, normals)
     keep_all = getattr(ms, FILTER)(min_boundary_edges=0)
     ms.set_current_mesh(0)
@@ -109,7 +111,7 @@ def test_small_holes_are_filled_only_below_the_threshold(plugin):
 
 
 def test_hole_layer_closes_the_surface(plugin):
-    points, normals, _ = point_cloud(SAMPLES / "bunny10k_textured.obj")
+    points, normals = point_cloud(SAMPLES / "bunny10k_textured.obj")
     ms = new_set(points, normals)
     result = getattr(ms, FILTER)(hole_layer=True)
     assert ms.mesh_number() == 3
@@ -126,7 +128,7 @@ def test_hole_layer_closes_the_surface(plugin):
 
 def test_closed_bunny_has_no_boundary(plugin):
     """Closed: no loop, and with hole_layer no empty holes layer is added."""
-    points, normals, _ = point_cloud(SAMPLES / "bunny.obj")
+    points, normals = point_cloud(SAMPLES / "bunny.obj")
     ms = new_set(points, normals)
     result = getattr(ms, FILTER)(hole_layer=True)
     assert result["boundary_loops"] == 0 and result["hole_faces"] == 0
@@ -137,7 +139,7 @@ def test_closed_bunny_has_no_boundary(plugin):
 
 
 def test_faces_follow_the_input_normals(plugin):
-    points, normals, _ = point_cloud(SAMPLES / "bunny.obj")
+    points, normals = point_cloud(SAMPLES / "bunny.obj")
     ms = new_set(points, normals)
     getattr(ms, FILTER)()
     out = ms.current_mesh()
@@ -147,7 +149,7 @@ def test_faces_follow_the_input_normals(plugin):
 
 
 def test_normals_are_estimated_when_the_layer_has_none(plugin):
-    points, normals, _ = point_cloud(SAMPLES / "bunny.obj")
+    points, normals = point_cloud(SAMPLES / "bunny.obj")
     ms = new_set(points)
     result = getattr(ms, FILTER)()
     assert result["normals_estimated"]
@@ -158,7 +160,7 @@ def test_normals_are_estimated_when_the_layer_has_none(plugin):
 
 
 def test_resolution_is_used_and_reported(plugin):
-    points, normals, _ = point_cloud(SAMPLES / "bunny10k_textured.obj")
+    points, normals = point_cloud(SAMPLES / "bunny10k_textured.obj")
     ms = new_set(points, normals)
     coarse = getattr(ms, FILTER)(resolution=40)
     ms.set_current_mesh(0)
@@ -200,7 +202,7 @@ def test_paper_occupancy_is_selectable(plugin):
     """The paper's SODS (cells holding samples, dilated) is what the filter uses when asked:
     its cell count is the one counted here, unlike the tangent disks' (the default); without
     the dilation it leaves the closed bunny full of holes, with one ring it closes it."""
-    points, normals, _ = point_cloud(SAMPLES / "bunny.obj")
+    points, normals = point_cloud(SAMPLES / "bunny.obj")
     runs = {}
     disks, cells = SodsOccupancy.TANGENT_DISKS, SodsOccupancy.SAMPLE_CELLS
     for occupancy, dilation in [(disks, 0), (cells, 0), (cells, 1)]:
@@ -256,7 +258,7 @@ def test_bad_layers_raise_clear_errors(plugin, make, message):
     (dict(resolution=400, extraction=Extraction.FULL_LATTICE, memory_limit=0.1), "use the SODS-driven"),
 ])
 def test_bad_parameters_raise_clear_errors(plugin, params, message):
-    points, normals, _ = point_cloud(SAMPLES / "bunny10k_textured.obj")
+    points, normals = point_cloud(SAMPLES / "bunny10k_textured.obj")
     ms = new_set(points, normals)
     with pytest.raises(pymeshlab.PyMeshLabException, match=message):
         getattr(ms, FILTER)(**params)
@@ -270,7 +272,7 @@ def test_filter_script_runs_and_matches_the_filter(plugin, tmp_path):
     from pathlib import Path
 
     script = Path(__file__).parent.parent / "meshlab_filters.xml"
-    points, normals, _ = point_cloud(SAMPLES / "bunny10k_textured.obj")
+    points, normals = point_cloud(SAMPLES / "bunny10k_textured.obj")
     ms = new_set(points, normals)
     ms.load_filter_script(str(script))
     ms.apply_filter_script()
@@ -312,7 +314,7 @@ print("loaded")
 def test_extraction_modes_by_name(plugin, extraction):
     """The full-lattice extractions evaluate every lattice corner; the gated one gives the
     SODS-driven mesh exactly, plain marching cubes the closed surface (no boundary loops)."""
-    points, normals, _ = point_cloud(SAMPLES / "bunny10k_textured.obj")
+    points, normals = point_cloud(SAMPLES / "bunny10k_textured.obj")
     ms = new_set(points, normals)
     sparse = getattr(ms, FILTER)()
     sparse_vertices = ms.current_mesh().vertex_matrix().copy()

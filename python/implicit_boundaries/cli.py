@@ -17,25 +17,12 @@ import pymeshlab
 
 from ._plugin import FILTER_NAME, PluginMismatchError, apply, describe_build, load, plugin_build, plugin_path
 from .alignment import read_alignment
+from .cloud import add_layer, read_cloud
 from .compare import compare
 from .options import Normals, SodsOccupancy
 from .reconstruct import loops_from_result
 
 DEMO_SCAN = Path(pymeshlab.__file__).parent / "tests" / "sample_meshes" / "bunny10k_textured.obj"
-
-
-def _point_cloud(ms: pymeshlab.MeshSet, path: Path, matrix=None) -> None:
-    """Adds a layer with the vertices and normals of `path` (faces ignored), with `matrix` (4x4,
-    taking the scan to the common frame) as its transformation matrix."""
-    if not path.is_file():
-        raise FileNotFoundError(f"{path}: no such file")
-    scan = pymeshlab.MeshSet()
-    scan.load_new_mesh(str(path))
-    m = scan.current_mesh()
-    m.compact()
-    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=m.vertex_matrix(), v_normals_matrix=m.vertex_normal_matrix()), path.stem)
-    if matrix is not None:
-        ms.set_matrix(transformmatrix=np.asarray(matrix, dtype=np.float64), freeze=False)
 
 
 def _scans(inputs, alignment=None) -> list:
@@ -122,7 +109,8 @@ def cmd_reconstruct(args) -> int:
     ms = pymeshlab.MeshSet()
     scans = _scans(args.input, getattr(args, "alignment", None))  # demo has none
     for path, matrix in scans:
-        _point_cloud(ms, path, matrix)
+        # Missing normals stay zero: the filter estimates them (facing --viewpoint when given).
+        add_layer(ms, read_cloud(path, estimate_normals=False), path.stem, matrix)
     if len(scans) > 1:
         print(f"merging {len(scans)} scans, {sum(ms.mesh(i).vertex_number() for i in range(len(scans)))} samples")
     result = _reconstruct(ms, args, merge_visible_layers=len(scans) > 1)

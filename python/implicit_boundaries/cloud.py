@@ -1,11 +1,14 @@
-"""The input point cloud: reading it from a file, and handing it to pymeshlab as a layer."""
+"""The input point cloud: reading it from a file (the one loader of the command line, the
+comparison, the tests and the benchmarks), and handing it to pymeshlab as a layer."""
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Tuple, Union
+from typing import Optional, Tuple, Union
 
 import numpy as np
 import pymeshlab
 from scipy.spatial import cKDTree
+
+from .options import NORMAL_NEIGHBOURS
 
 
 @dataclass
@@ -40,17 +43,22 @@ def _load(path: Path) -> pymeshlab.MeshSet:
     return ms
 
 
-def read_cloud(path: Union[str, Path]) -> Cloud:
-    """The vertices and normals of any file pymeshlab reads (faces ignored); normals are
-    estimated (10 neighbours) when the file has none."""
+def read_cloud(path: Union[str, Path], estimate_normals: bool = True) -> Cloud:
+    """The (n, 3) vertices and (n, 3) normals of any file pymeshlab reads, faces dropped (a
+    mesh file's normals are those MeshLab computes from its faces on loading).
+
+    When the file has no normals: estimate_normals=True estimates them with MeshLab's point
+    cloud normals over the filter's number of neighbours (what screened Poisson needs);
+    False leaves them zero, which our filter takes as missing and estimates itself.
+    """
     path = Path(path)
     ms = _load(path)
     mesh = ms.current_mesh()
     mesh.compact()
     if mesh.vertex_number() == 0:
         raise ValueError(f"{path}: no vertices")
-    if not np.any(mesh.vertex_normal_matrix()):
-        ms.compute_normal_for_point_clouds(k=10)
+    if estimate_normals and not np.any(mesh.vertex_normal_matrix()):
+        ms.compute_normal_for_point_clouds(k=NORMAL_NEIGHBOURS)
         mesh = ms.current_mesh()
     return Cloud(mesh.vertex_matrix().copy(), mesh.vertex_normal_matrix().copy())
 
@@ -65,6 +73,9 @@ def read_mesh(path: Union[str, Path]) -> Tuple[np.ndarray, np.ndarray]:
     return vertices, faces
 
 
-def add_layer(ms: pymeshlab.MeshSet, cloud: Cloud, name: str = "points") -> None:
-    """Adds the cloud to `ms` as a new current layer called `name`."""
+def add_layer(ms: pymeshlab.MeshSet, cloud: Cloud, name: str = "points", matrix: Optional[np.ndarray] = None) -> None:
+    """Adds the cloud to `ms` as a new current layer called `name`, with `matrix` (4, 4), the
+    transformation taking a scan to the common frame of several, as its layer matrix."""
     ms.add_mesh(pymeshlab.Mesh(vertex_matrix=cloud.points, v_normals_matrix=cloud.normals), name)
+    if matrix is not None:
+        ms.set_matrix(transformmatrix=np.asarray(matrix, dtype=np.float64), freeze=False)

@@ -1,5 +1,6 @@
 """The values of the filter's enum parameters, spelt exactly as the plugin's dialog and
-pymeshlab take them, e.g. ``apply(ms, implicit=Implicit.HOPPE)``.
+pymeshlab take them, e.g. ``apply(ms, implicit=Implicit.HOPPE)``, and the one default the
+Python side repeats.
 
 Each class is named after its parameter and lists its labels in the plugin's order (the index
 the filter's result dictionary reports: ``result["implicit"] == 0`` is ``Implicit.PU_RBF``);
@@ -40,3 +41,7 @@ class Extraction:
 
 # Every enum parameter of the filter, by its pymeshlab name.
 ENUMS = {"implicit": Implicit, "sods_occupancy": SodsOccupancy, "normals": Normals, "extraction": Extraction}
+
+# The filter's default normal_neighbours: normals the Python side estimates (screened Poisson
+# needs them) use as many neighbours as the filter's own estimate.
+NORMAL_NEIGHBOURS = 15
