@@ -49,8 +49,8 @@ def test_compare_writes_the_report_and_prints_the_table(sphere_files, tmp_path, 
                  "--trim-quantile", "0.1"]) == 0
     captured = capsys.readouterr()
     lines = {line.split("|")[1].strip(): line for line in captured.out.splitlines() if line.startswith("| ")}
-    assert {"ours", "screened Poisson", "screened Poisson + density trim"} <= set(lines)
-    assert "| 2/2 |" in lines["ours"]
+    assert {"implicit with boundaries", "screened Poisson", "screened Poisson + density trim"} <= set(lines)
+    assert "| 2/2 |" in lines["implicit with boundaries"]
     assert f"report: {report / 'report.html'}" in captured.out
     assert "0.1" in (report / "report.html").read_text()  # the trim quantile used
     assert re.search(r"\b(\d+)/\1 done", captured.err)  # the progress bar, to its end

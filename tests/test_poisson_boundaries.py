@@ -22,7 +22,7 @@ def test_poisson_on_a_hemisphere_keeps_one_loop_and_no_bulge(hemisphere):
     filter keeps the Poisson surface where the samples are and one loop at the rim."""
     ms = pymeshlab.MeshSet()
     ms.add_mesh(pymeshlab.Mesh(vertex_matrix=hemisphere, v_normals_matrix=hemisphere), "hemisphere")
-    info = poisson_with_boundaries(ms)
+    info = poisson_with_boundaries(ms).info
     assert ms.mesh_number() == 3 and ms.current_mesh_id() == 2
     poisson = ms.mesh(1)
     assert poisson.vertex_matrix()[:, 2].min() < -0.3  # the bulge

@@ -93,9 +93,10 @@ def compare(input, ground_truth=None, *, resolution: int = 0, depth: Optional[in
     if truth is not None:
         truth = (np.asarray(truth[0], dtype=np.float64), np.asarray(truth[1], dtype=np.int64))
         truth_loops = [truth[0][h] for h in metrics.boundary_vertex_sets(truth[1], len(truth[0]))]
-        ours = next((s.info for s in surfaces.values() if "sample_spacing" in s.info), None)
+        filter_run = next((s.info for s in surfaces.values() if "sample_spacing" in s.info), None)
         # As the benchmark: a loop is on a true boundary within a few sample spacings and cells.
-        loop_tolerance = 2.5 * ours["sample_spacing"] + 2 * ours["cell_size"] if ours else 0.01 * cloud.diagonal
+        loop_tolerance = 2.5 * filter_run["sample_spacing"] + 2 * filter_run["cell_size"] if filter_run \
+            else 0.01 * cloud.diagonal
     for k, (name, surface) in enumerate(surfaces.items()):
         tell(len(methods) + k, steps, f"measuring {name}")
         row = {"method": name, "seconds": surface.info["seconds"]}

@@ -37,7 +37,7 @@ class Settings:
     def as_dict(self) -> Dict[str, object]:
         """The settings as a flat dict (the filter's parameters prefixed), for the report."""
         flat = asdict(self)
-        flat.update({f"ours: {k}": v for k, v in flat.pop("params").items()})
+        flat.update({f"filter: {k}": v for k, v in flat.pop("params").items()})
         return flat
 
     def poisson_depth(self) -> int:
@@ -49,7 +49,7 @@ class Settings:
 class Surface:
     """A method's output: (m, 3) vertices, (f, 3) faces; holes: the triangles that would close
     its kept holes, as (vertices, faces), when the method gives them (pictures show them
-    tinted); info: numbers the method reports (ours: the filter's result dictionary)."""
+    tinted); info: numbers the method reports (our filter's runs: its result dictionary)."""
     vertices: np.ndarray
     faces: np.ndarray
     holes: Optional[Tuple[np.ndarray, np.ndarray]] = None
@@ -65,7 +65,7 @@ def _meshset(cloud: Cloud) -> pymeshlab.MeshSet:
     return ms
 
 
-def run_ours(cloud: Cloud, settings: Settings) -> Surface:
+def run_implicit_with_boundaries(cloud: Cloud, settings: Settings) -> Surface:
     """Our filter, its kept holes in their own layer."""
     load()
     ms = _meshset(cloud)
@@ -113,17 +113,17 @@ def run_poisson_with_boundaries(cloud: Cloud, settings: Settings) -> Surface:
     """MeshLab's screened Poisson surface as our filter's implicit function: Poisson's
     surface where the samples are, with the scan's boundaries."""
     ms = _meshset(cloud)
-    info = dict(poisson_with_boundaries(ms, depth=settings.poisson_depth(), poisson_threads=settings.poisson_threads,
-                                        resolution=settings.resolution, hole_layer=True, **settings.params))
+    info = poisson_with_boundaries(ms, depth=settings.poisson_depth(), poisson_threads=settings.poisson_threads,
+                                   resolution=settings.resolution, hole_layer=True, **settings.params).info
     vertices, faces = mesh_arrays(ms.mesh(2))
     holes = mesh_arrays(ms.mesh(3)) if ms.mesh_number() > 3 else None
     return Surface(vertices, faces, holes, info)
 
 
-# Ours first: the others run at the resolution it chose.
+# Our filter first: the others run at the resolution it chose.
 METHODS: Dict[str, Method] = {
-    "ours": run_ours,
+    "implicit with boundaries": run_implicit_with_boundaries,
     "screened Poisson": run_poisson,
     "screened Poisson + density trim": run_poisson_trimmed,
-    "screened Poisson + our boundaries": run_poisson_with_boundaries,
+    "screened Poisson with boundaries": run_poisson_with_boundaries,
 }
