@@ -1,4 +1,4 @@
-"""Boundary benchmark on the meshes with known boundaries (DESIGN.md section 5, first part).
+"""Boundary benchmark on the meshes with known boundaries (docs/yardsticks.md: the boundary yardsticks).
 
 For each mesh: its vertices and face normals as the input point cloud, reconstructed with our
 defaults (tangent-disk SODS, automatic resolution) and variants; reports loops found against

@@ -78,7 +78,7 @@ def boundary_edges(faces: np.ndarray) -> np.ndarray:
 
 def boundary_distance(truth: Sequence[np.ndarray], loops: Sequence[np.ndarray]) -> float:
     """Symmetric mean distance between the true boundary points and the found loop points
-    (DESIGN.md section 5): each a list of (k, 3) point arrays, best the dense points of
+    (docs/yardsticks.md): each a list of (k, 3) point arrays, best the dense points of
     :func:`boundary_curves` (then it is the distance between the curves, to within half their
     step). 0 when neither side has a boundary, nan when only one has."""
     if not len(truth) or not len(loops):
@@ -167,7 +167,7 @@ def point_mesh_distance(points: np.ndarray, vertices: np.ndarray, faces: np.ndar
 
 def surface_distances(vertices, faces, truth_vertices, truth_faces, tolerance: float,
                       samples: int = 20000) -> Dict[str, float]:
-    """Distances between a result mesh and a true mesh (DESIGN.md section 5), in the units of
+    """Distances between a result mesh and a true mesh (docs/yardsticks.md), in the units of
     the vertices, from `samples` area-uniform points on each:
 
     chamfer: the mean of the two mean sample-to-other-mesh distances; spurious: fraction of
