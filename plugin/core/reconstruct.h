@@ -224,7 +224,7 @@ private:
                                      std::max(2.0, 2 * kSlabPerSpacing * r.sample_spacing / cell);
         r.memory_estimate = CheckMemory(p, lattice, double(input.rows()), expectedCells, r);
         const std::unique_ptr<ImplicitFunction> fitted =
-            p.implicit == Implicit::Given ? nullptr : MakeImplicit(P, normals, samples, p, cb);
+            p.implicit == Implicit::Given ? nullptr : MakeImplicit(P, normals, samples, spacing, p, cb);
         const ImplicitFunction& f = fitted ? *fitted : *p.given;
         if (const auto* rbf = dynamic_cast<const PuRbf*>(fitted.get()))
             r.rbf_cells = rbf->Cells();
@@ -295,14 +295,17 @@ private:
         return r;
     }
 
-    /// The implicit function p asks for, fitted to the samples P with unit normals N.
+    /// The implicit function p asks for, fitted to the samples P with unit normals N and local
+    /// `spacing` (within each sample's own scan).
     static std::unique_ptr<ImplicitFunction> MakeImplicit(const Points& P, const Points& N, const SampleIndex& samples,
-                                                          const Param& p, vcg::CallBackPos* cb)
+                                                          const Eigen::VectorXd& spacing, const Param& p,
+                                                          vcg::CallBackPos* cb)
     {
         if (p.implicit == Implicit::Hoppe)
             return std::make_unique<HoppeDistance>(samples, N, p.hoppe_neighbours, p.threads);
         PuRbf::Param rp = p.rbf;
         rp.threads = p.threads;
+        rp.spacing = spacing;
         try {
             return std::make_unique<PuRbf>(P, N, rp, ProgressRange::Into(cb, 5, 35));
         } catch (const std::invalid_argument& e) {

@@ -22,9 +22,10 @@
 /// points of some of them, which are also its centres u_j, under the moment conditions.
 ///
 /// Off-surface distance: e_i = `off_surface` (default 1) times the local sample spacing at
-/// sample i (spacing.h; clamped to [0.5, 2] times the median spacing so isolated samples and
-/// piles of duplicates get a sane value). The spacing, not the cell size, sets e because it is
-/// the scale of detail the samples resolve, and it does not change with min/max_samples. On the
+/// sample i (spacing.h, or Param::spacing; clamped to [0.5, 2] times the median spacing so
+/// isolated samples and piles of duplicates get a sane value). The spacing, not the cell size,
+/// sets e because it is the scale of detail the samples resolve, and it does not change with
+/// min/max_samples. On the
 /// tests' sphere and torus, clean or noisy, 0.5 to 2 spacings give the same accuracy within
 /// ~25%; one spacing stays above scan noise (a fraction of a spacing) while keeping the points
 /// on the right side of thin parts. The standard check (Carr et al. 2001): an off-surface point
@@ -79,6 +80,11 @@ public:
         int max_centres = 80;          ///< RBF centres per local function: a third on samples, the rest
                                        ///< their off-surface points (advanced)
         int threads = 0;               ///< 0 = all cores
+        /// n local sample spacings, one per row of P, that set the off-surface distances; empty:
+        /// measured among all samples. Merged range scans pass the spacing within each sample's
+        /// own scan: overlapping scans multiply the density but lie apart by their registration
+        /// error, so off-surface points one merged spacing out land on the next scan's sheet.
+        Eigen::VectorXd spacing;
     };
 
     struct Stats
@@ -119,6 +125,8 @@ public:
               param.max_fit_samples >= 1 && param.max_centres >= 1))
             throw std::invalid_argument("PuRbf: min_samples, max_samples, max_fit_samples and max_centres must be "
                                         ">= 1, overlap >= 1 and off_surface > 0");
+        if (param.spacing.size() != 0 && param.spacing.size() != P.rows())
+            throw std::invalid_argument("PuRbf: one spacing per sample, or none");
         const auto start = std::chrono::steady_clock::now();
         auto progress = [&](int percent, const char* what) { if (cb) cb(percent, what); };
         progress(0, "PU-RBF: octree");
@@ -218,7 +226,8 @@ private:
     /// e per sample and side (+ outside, - inside); 0 where the off-surface point is dropped.
     void OffSurfacePoints()
     {
-        const Eigen::VectorXd spacing = SampleSpacing::Local(index_, 1, param_.threads);
+        const Eigen::VectorXd spacing =
+            param_.spacing.size() ? param_.spacing : SampleSpacing::Local(index_, 1, param_.threads);
         double median = SampleSpacing::Median(spacing);
         if (!(median > 0))  // most samples duplicated many times: fall back to the area per sample
             median = (P_.colwise().maxCoeff() - P_.colwise().minCoeff()).norm() / std::sqrt(double(P_.rows()));

@@ -600,3 +600,44 @@ TEST(PuRbf, SpeedReport)
                     long(Q.rows()));
     }
 }
+
+TEST(PuRbf, TwoOverlappingSheetsWithTheirOwnSpacingGiveOneZeroCrossing)
+{
+    // Two scans of the plane z = 0, each a jittered grid of spacing h, the second 0.6 h higher
+    // (a registration error). Merged, the samples are twice as dense: off-surface points one
+    // merged spacing out land next to the other sheet. With each scan's own spacing they clear
+    // it, and every vertical line crosses zero once, between the sheets.
+    const double h = 0.05, lift = 0.6 * h;
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> jitter(-0.2 * h, 0.2 * h);
+    std::vector<Eigen::Vector3d> ps;
+    for (int sheet = 0; sheet < 2; ++sheet)
+        for (int i = 0; i < 40; ++i)
+            for (int j = 0; j < 40; ++j)
+                ps.emplace_back((i + 0.5 * sheet) * h + jitter(rng), (j + 0.5 * sheet) * h + jitter(rng), sheet * lift);
+    Points P(Eigen::Index(ps.size()), 3);
+    for (size_t i = 0; i < ps.size(); ++i)
+        P.row(Eigen::Index(i)) = ps[i];
+    const Points N = Points::Zero(P.rows(), 3).rowwise() + Eigen::RowVector3d(0, 0, 1);
+    PuRbf::Param own;
+    own.spacing = Eigen::VectorXd::Constant(P.rows(), h);
+    const PuRbf f(P, N, own);
+    EXPECT_DOUBLE_EQ(f.Statistics().median_spacing, h);
+    int lines = 0, single = 0;
+    for (double x = 0.5; x < 1.5; x += 0.1)
+        for (double y = 0.5; y < 1.5; y += 0.1, ++lines) {
+            Points Q(81, 3);
+            for (int k = 0; k < 81; ++k)
+                Q.row(k) << x, y, -2 * h + 4 * h * k / 80.0;
+            Eigen::VectorXd v(81);
+            f.Eval(Q, v);
+            int crossings = 0;
+            for (int k = 1; k < 81; ++k)
+                crossings += (v[k - 1] < 0) != (v[k] < 0);
+            single += crossings == 1 && v[0] < 0 && v[80] > 0;
+        }
+    EXPECT_EQ(single, lines);
+    PuRbf::Param wrong;
+    wrong.spacing = Eigen::VectorXd::Constant(10, h);
+    EXPECT_THROW(PuRbf(P, N, wrong), std::invalid_argument);
+}
