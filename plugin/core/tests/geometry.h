@@ -9,7 +9,9 @@
 #include <vcg/complex/algorithms/clean.h>
 #include <vcg/complex/algorithms/update/topology.h>
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 namespace ib::test {
 
@@ -33,6 +35,55 @@ inline void SpherePoints(int n, double radius, Points& P, Points& N, double zmin
         P.row(Eigen::Index(i)) = ps[i].transpose();
         N.row(Eigen::Index(i)) = ns[i].transpose();
     }
+}
+
+/// A flat square scan: samples on a staggered grid of spacing s over [0, 1]^2 at z = 0.
+inline void FlatScan(double s, Points& P, Points& N)
+{
+    std::vector<Eigen::Vector3d> pts;
+    const int n = int(std::round(1 / s));
+    for (int j = 0; j <= n; ++j)
+        for (int i = 0; i <= n; ++i)
+            pts.emplace_back(std::min(1.0, (i + 0.5 * (j % 2)) * s), j * s, 0.0);
+    P.resize(Eigen::Index(pts.size()), 3);
+    N.resize(Eigen::Index(pts.size()), 3);
+    for (size_t i = 0; i < pts.size(); ++i) {
+        P.row(Eigen::Index(i)) = pts[i].transpose();
+        N.row(Eigen::Index(i)) << 0, 0, 1;
+    }
+}
+
+/// Adds the triangle a, b, c to m (new vertices; weld with Clean::RemoveDuplicateVertex).
+inline void AddTriangle(CoreMesh& m, const vcg::Point3d& a, const vcg::Point3d& b, const vcg::Point3d& c)
+{
+    vcg::tri::Allocator<CoreMesh>::AddFace(m, a, b, c);
+}
+
+/// Welds the duplicate vertices of a mesh made of AddTriangle calls, compacts it and builds
+/// its face-face adjacency.
+inline void Weld(CoreMesh& m)
+{
+    vcg::tri::Clean<CoreMesh>::RemoveDuplicateVertex(m);
+    vcg::tri::Allocator<CoreMesh>::CompactEveryVector(m);
+    vcg::tri::UpdateTopology<CoreMesh>::FaceFace(m);
+}
+
+/// A flat triangulated grid of n × n squares of side h in the plane z = 0, from the origin,
+/// each square split along its diagonal; faces counter-clockwise seen from +z. Vertex (i, j)
+/// has index j (n + 1) + i.
+inline void Grid(int n, double h, CoreMesh& m)
+{
+    auto v = vcg::tri::Allocator<CoreMesh>::AddVertices(m, size_t((n + 1) * (n + 1)));
+    for (int j = 0; j <= n; ++j)
+        for (int i = 0; i <= n; ++i, ++v)
+            v->P() = vcg::Point3d(i * h, j * h, 0);
+    auto at = [&](int i, int j) { return &m.vert[size_t(j * (n + 1) + i)]; };
+    for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) {
+            vcg::tri::Allocator<CoreMesh>::AddFace(m, at(i, j), at(i + 1, j), at(i + 1, j + 1));
+            vcg::tri::Allocator<CoreMesh>::AddFace(m, at(i, j), at(i + 1, j + 1), at(i, j + 1));
+        }
+    vcg::tri::UpdateTopology<CoreMesh>::FaceFace(m);
 }
 
 /// Exact signed distance to a sphere (negative inside).

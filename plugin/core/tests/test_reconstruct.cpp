@@ -311,21 +311,3 @@ TEST(Reconstruction, CancelStopsAtEveryStageAndLeavesNothing)
         EXPECT_EQ(again.face.size(), m.face.size());
     }
 }
-
-TEST(ParallelFor, RethrowsOnceEveryThreadHasFinished)
-{
-    std::vector<int> done(4, 0);
-    auto work = [&](size_t begin, size_t end, int thread) {
-        for (size_t i = begin; i < end; ++i)
-            done[size_t(thread)] += 1;
-        if (thread == 0 || thread == 2)
-            throw std::runtime_error("block " + std::to_string(thread));
-    };
-    try {
-        ParallelFor(4000, 4, work, 1000);
-        FAIL() << "no exception";
-    } catch (const std::runtime_error& e) {
-        EXPECT_STREQ(e.what(), "block 0");
-    }
-    EXPECT_EQ(done, (std::vector<int>{1000, 1000, 1000, 1000}));
-}
