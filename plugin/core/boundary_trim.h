@@ -15,6 +15,7 @@
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <array>
 #include <deque>
 #include <vector>
@@ -152,7 +153,9 @@ private:
         const Eigen::Vector3d u = n.unitOrthogonal(), v = n.cross(u);
         samples.Nearest(c, kAround, queue);
         std::array<double, kAround> angle;
-        const int found = queue.getNofElements();
+        // The query returns at most kAround; saying so lets GCC 12 see that std::sort stays
+        // inside `angle` (-Warray-bounds otherwise follows its path for more than 16 elements).
+        const int found = std::clamp(queue.getNofElements(), 0, kAround);
         for (int i = 0; i < found; ++i) {
             const Eigen::Vector3d d = samples.P().row(queue.getIndex(i)).transpose() - c;
             angle[size_t(i)] = std::atan2(d.dot(v), d.dot(u));
