@@ -4,7 +4,7 @@
 /// input gets a message that says what is wrong and what to do, never a crash: at least
 /// kMinPoints finite samples spread in two directions, one normal per sample (or none).
 
-#include "mesh.h"
+#include "lattice.h"
 
 #include <Eigen/Eigenvalues>
 
