@@ -60,7 +60,7 @@ test-sanitize:
 	  -DIB_BUILD_PLUGIN=OFF -DIB_SANITIZE=ON -DMESHLAB_SOURCE_DIR="$$(.ci/meshlab-source)"
 	cmake --build $(SANITIZE_BUILD) -j $(JOBS)
 	cd $(SANITIZE_BUILD) && ASAN_OPTIONS=halt_on_error=1:abort_on_error=1:detect_leaks=1:strict_string_checks=1 \
-	  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 ctest --output-on-failure -j $(JOBS) -E SpeedReport  # timing only: slow here
+	  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 ctest --output-on-failure -j $(JOBS)
 
 # Property-based fuzzing of the filter with many random examples (make test runs a bounded few).
 fuzz: plugin

@@ -11,6 +11,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
+#include <random>
 #include <vector>
 
 namespace ib::test {
@@ -127,6 +129,92 @@ inline Topology Check(CoreMesh& m)
     vcg::tri::Clean<CoreMesh>::CountEdgeNum(m, total, t.border_edges, nonManifold);
     t.oriented = vcg::tri::Clean<CoreMesh>::IsCoherentlyOrientedMesh(m);
     return t;
+}
+
+/// Torus around the z axis (tube centre radius R, tube radius r): samples about uniform in
+/// area (rings around the tube get points in proportion to their length), outward normals.
+inline void TorusPoints(int rings, double R, double r, Points& P, Points& N)
+{
+    std::vector<Eigen::Vector3d> ps, ns;
+    const int around = int(std::lround(rings * R / r));  // points on the ring of radius R
+    for (int j = 0; j < rings; ++j) {
+        const double v = 2 * M_PI * (j + 0.5) / rings;
+        const int count = std::max(3, int(std::lround(around * (R + r * std::cos(v)) / R)));
+        for (int i = 0; i < count; ++i) {
+            const double u = 2 * M_PI * (i + 0.37 * j) / count;
+            const Eigen::Vector3d n(std::cos(v) * std::cos(u), std::cos(v) * std::sin(u), std::sin(v));
+            ps.push_back(Eigen::Vector3d(R * std::cos(u), R * std::sin(u), 0) + r * n);
+            ns.push_back(n);
+        }
+    }
+    P.resize(Eigen::Index(ps.size()), 3);
+    N.resize(Eigen::Index(ps.size()), 3);
+    for (size_t i = 0; i < ps.size(); ++i) {
+        P.row(Eigen::Index(i)) = ps[i].transpose();
+        N.row(Eigen::Index(i)) = ns[i].transpose();
+    }
+}
+
+/// A known surface: exact signed distance, and its closest point and normal.
+struct Shape
+{
+    std::function<double(const Eigen::Vector3d&)> distance;
+    std::function<Eigen::Vector3d(const Eigen::Vector3d&)> normal;  // of the closest surface point
+};
+
+inline Shape Sphere(double radius)
+{
+    return {[=](const Eigen::Vector3d& x) { return x.norm() - radius; },
+            [](const Eigen::Vector3d& x) { return x.normalized(); }};
+}
+
+inline Shape Torus(double R, double r)
+{
+    auto axis = [=](const Eigen::Vector3d& x) {  // closest point on the tube's centre circle
+        const Eigen::Vector2d d = x.head<2>().normalized();
+        return Eigen::Vector3d(R * d[0], R * d[1], 0);
+    };
+    return {[=](const Eigen::Vector3d& x) { return (x - axis(x)).norm() - r; },
+            [=](const Eigen::Vector3d& x) { return (x - axis(x)).normalized(); }};
+}
+
+/// Gaussian noise on the positions with RMS displacement `rms` (deterministic).
+inline void AddNoise(Points& P, double rms, unsigned seed = 7)
+{
+    std::mt19937 rng(seed);
+    std::normal_distribution<double> g(0, rms / std::sqrt(3.0));
+    for (Eigen::Index i = 0; i < P.rows(); ++i)
+        for (int a = 0; a < 3; ++a)
+            P(i, a) += g(rng);
+}
+
+inline double Diagonal(const Points& P) { return (P.colwise().maxCoeff() - P.colwise().minCoeff()).norm(); }
+
+/// Points on the true surface that are not the samples: the samples of a denser set moved by
+/// the shape's own projection.
+inline Points OnSurface(const Points& Q, const Shape& s)
+{
+    Points S = Q;
+    for (Eigen::Index i = 0; i < S.rows(); ++i) {
+        const Eigen::Vector3d x = S.row(i).transpose();
+        S.row(i) = (x - s.distance(x) * s.normal(x)).transpose();
+    }
+    return S;
+}
+
+/// A regular grid of m^3 points covering the samples' bounding box scaled by 2 about its centre.
+inline Points GridAround(const Points& P, int m)
+{
+    const Eigen::Vector3d lo = P.colwise().minCoeff(), hi = P.colwise().maxCoeff();
+    const Eigen::Vector3d c = 0.5 * (lo + hi), ext = (hi - lo).cwiseMax(1e-3 * (hi - lo).maxCoeff());
+    Points G(Eigen::Index(m) * m * m, 3);
+    Eigen::Index k = 0;
+    for (int z = 0; z < m; ++z)
+        for (int y = 0; y < m; ++y)
+            for (int x = 0; x < m; ++x)
+                G.row(k++) = (c + ext.cwiseProduct(Eigen::Vector3d(x, y, z) / (m - 1) * 2 - Eigen::Vector3d::Ones()))
+                                 .transpose();
+    return G;
 }
 
 } // namespace ib::test

@@ -1,151 +1,30 @@
+// PU-RBF accuracy on known shapes (sphere, torus, flat patch, a sparse half): |f| on the
+// surface, f against the signed distance near it, signs farther off, and marching cubes on it;
+// with exact and estimated normals, with and without noise. Robustness (degenerate input,
+// threads, progress) is in test_pu_rbf_robustness.cpp.
 #include "gated_mc.h"
 #include "geometry.h"
-#include "implicit/hoppe.h"
 #include "implicit/pu_rbf.h"
+#include "implicit_accuracy.h"
 #include "normals.h"
 
 #include <gtest/gtest.h>
 
-#include <chrono>
 #include <cstdio>
-#include <cstring>
-#include <functional>
-#include <random>
 
 using namespace ib;
 
 namespace {
-
-/// Torus around the z axis (tube centre radius R, tube radius r): samples about uniform in
-/// area (rings around the tube get points in proportion to their length), outward normals.
-void TorusPoints(int rings, double R, double r, Points& P, Points& N)
-{
-    std::vector<Eigen::Vector3d> ps, ns;
-    const int around = int(std::lround(rings * R / r));  // points on the ring of radius R
-    for (int j = 0; j < rings; ++j) {
-        const double v = 2 * M_PI * (j + 0.5) / rings;
-        const int count = std::max(3, int(std::lround(around * (R + r * std::cos(v)) / R)));
-        for (int i = 0; i < count; ++i) {
-            const double u = 2 * M_PI * (i + 0.37 * j) / count;
-            const Eigen::Vector3d n(std::cos(v) * std::cos(u), std::cos(v) * std::sin(u), std::sin(v));
-            ps.push_back(Eigen::Vector3d(R * std::cos(u), R * std::sin(u), 0) + r * n);
-            ns.push_back(n);
-        }
-    }
-    P.resize(Eigen::Index(ps.size()), 3);
-    N.resize(Eigen::Index(ps.size()), 3);
-    for (size_t i = 0; i < ps.size(); ++i) {
-        P.row(Eigen::Index(i)) = ps[i].transpose();
-        N.row(Eigen::Index(i)) = ns[i].transpose();
-    }
-}
-
-/// A known surface: exact signed distance, and its closest point and normal.
-struct Shape
-{
-    std::function<double(const Eigen::Vector3d&)> distance;
-    std::function<Eigen::Vector3d(const Eigen::Vector3d&)> normal;  // of the closest surface point
-};
-
-Shape Sphere(double radius)
-{
-    return {[=](const Eigen::Vector3d& x) { return x.norm() - radius; },
-            [](const Eigen::Vector3d& x) { return x.normalized(); }};
-}
-
-Shape Torus(double R, double r)
-{
-    auto axis = [=](const Eigen::Vector3d& x) {  // closest point on the tube's centre circle
-        const Eigen::Vector2d d = x.head<2>().normalized();
-        return Eigen::Vector3d(R * d[0], R * d[1], 0);
-    };
-    return {[=](const Eigen::Vector3d& x) { return (x - axis(x)).norm() - r; },
-            [=](const Eigen::Vector3d& x) { return (x - axis(x)).normalized(); }};
-}
-
-/// Gaussian noise on the positions with RMS displacement `rms` (deterministic).
-void AddNoise(Points& P, double rms, unsigned seed = 7)
-{
-    std::mt19937 rng(seed);
-    std::normal_distribution<double> g(0, rms / std::sqrt(3.0));
-    for (Eigen::Index i = 0; i < P.rows(); ++i)
-        for (int a = 0; a < 3; ++a)
-            P(i, a) += g(rng);
-}
-
-double Diagonal(const Points& P) { return (P.colwise().maxCoeff() - P.colwise().minCoeff()).norm(); }
-
-/// Points on the true surface that are not the samples: the samples of a denser set moved by
-/// the shape's own projection.
-Points OnSurface(const Points& Q, const Shape& s)
-{
-    Points S = Q;
-    for (Eigen::Index i = 0; i < S.rows(); ++i) {
-        const Eigen::Vector3d x = S.row(i).transpose();
-        S.row(i) = (x - s.distance(x) * s.normal(x)).transpose();
-    }
-    return S;
-}
-
-struct Accuracy
-{
-    double max_abs = 0, mean_abs = 0;        ///< |f| on the true surface, in spacings
-    double max_sd_error = 0;                 ///< |f - signed distance| at +-0.5 spacing, in spacings
-    int wrong_sign = 0;                      ///< at +-3 spacings
-};
-
-/// Evaluates f on the true surface (at Q projected) and offset along the true normals.
-Accuracy Measure(const ImplicitFunction& f, const Points& Q, const Shape& s, double spacing)
-{
-    const Points S = OnSurface(Q, s);
-    Points Nt(S.rows(), 3);
-    for (Eigen::Index i = 0; i < S.rows(); ++i)
-        Nt.row(i) = s.normal(S.row(i).transpose()).transpose();
-    Accuracy a;
-    Eigen::VectorXd v(S.rows());
-    f.Eval(S, v);
-    a.max_abs = v.cwiseAbs().maxCoeff() / spacing;
-    a.mean_abs = v.cwiseAbs().mean() / spacing;
-    for (double offset : {-3.0, 3.0}) {
-        f.Eval(Points(S + offset * spacing * Nt), v);
-        for (Eigen::Index i = 0; i < v.size(); ++i)
-            a.wrong_sign += (v[i] > 0) != (offset > 0);
-    }
-    for (double offset : {-0.5, 0.5}) {
-        f.Eval(Points(S + offset * spacing * Nt), v);
-        a.max_sd_error = std::max(a.max_sd_error, (v.array() - offset * spacing).abs().maxCoeff() / spacing);
-    }
-    return a;
-}
-
-/// A regular grid of m^3 points covering the samples' bounding box scaled by 2 about its centre.
-Points GridAround(const Points& P, int m)
-{
-    const Eigen::Vector3d lo = P.colwise().minCoeff(), hi = P.colwise().maxCoeff();
-    const Eigen::Vector3d c = 0.5 * (lo + hi), ext = (hi - lo).cwiseMax(1e-3 * (hi - lo).maxCoeff());
-    Points G(Eigen::Index(m) * m * m, 3);
-    Eigen::Index k = 0;
-    for (int z = 0; z < m; ++z)
-        for (int y = 0; y < m; ++y)
-            for (int x = 0; x < m; ++x)
-                G.row(k++) = (c + ext.cwiseProduct(Eigen::Vector3d(x, y, z) / (m - 1) * 2 - Eigen::Vector3d::Ones()))
-                                 .transpose();
-    return G;
-}
-
-bool AllFiniteOnGrid(const ImplicitFunction& f, const Points& P)
-{
-    const Points G = GridAround(P, 40);
-    Eigen::VectorXd v(G.rows());
-    f.Eval(G, v);
-    return v.allFinite();
-}
-
-void Print(const char* what, const Accuracy& a)
-{
-    std::printf("[ PU-RBF   ] %-28s |f| on surface: max %.4f mean %.5f spacings; |f - sd| at 0.5 spacing: max %.4f; wrong signs at 3 spacings: %d\n",
-                what, a.max_abs, a.mean_abs, a.max_sd_error, a.wrong_sign);
-}
+using test::Accuracy;
+using test::AddNoise;
+using test::AllFiniteOnGrid;
+using test::Diagonal;
+using test::Measure;
+using test::Print;
+using test::Shape;
+using test::Sphere;
+using test::Torus;
+using test::TorusPoints;
 
 /// The accuracy tests' known surfaces: samples P with exact normals N, other points Q of the
 /// same surface to measure at, and the sample spacing.
@@ -285,27 +164,6 @@ TEST(PuRbf, TorusWithNoiseAndEstimatedNormals)
     EXPECT_LT(a.max_abs, 0.75);
 }
 
-// A lone sample in its own octree leaf above a dense flat scan: its support box must not grow
-// with the leaf's cube over the whole scan (was 17 spacings off the plane below it).
-TEST(PuRbf, LoneSampleLeafDoesNotSpanTheScan)
-{
-    const double spacing = 0.01;
-    std::vector<Eigen::RowVector3d> ps;
-    for (int i = 0; i <= 200; ++i)
-        for (int j = 0; j <= 200; ++j)
-            ps.emplace_back(-1 + spacing * i, -1 + spacing * j, 0);
-    ps.emplace_back(0.3, 0.3, 0.5);
-    Points P(Eigen::Index(ps.size()), 3), N(Eigen::Index(ps.size()), 3);
-    for (size_t i = 0; i < ps.size(); ++i) {
-        P.row(Eigen::Index(i)) = ps[i];
-        N.row(Eigen::Index(i)) << 0, 0, 1;
-    }
-    const PuRbf f(P, N);
-    Eigen::VectorXd value(P.rows() - 1);
-    f.Eval(P.topRows(P.rows() - 1), value);
-    EXPECT_LT(value.cwiseAbs().maxCoeff(), 0.05 * spacing);
-}
-
 TEST(PuRbf, SparseRegionNextToADenseOne)
 {
     // The upper hemisphere dense, the lower one 16 times sparser: the lower cells hold fewer
@@ -338,60 +196,6 @@ TEST(PuRbf, SparseRegionNextToADenseOne)
     EXPECT_TRUE(AllFiniteOnGrid(f, P));
 }
 
-TEST(PuRbf, SameValuesForOneAndTwoThreads)
-{
-    Points P, N;
-    TorusPoints(60, 1.0, 0.35, P, N);
-    AddNoise(P, 0.002);
-    PuRbf::Param one, two;
-    one.threads = 1;
-    two.threads = 2;
-    const PuRbf f1(P, N, one), f2(P, N, two);
-    const Points G = GridAround(P, 48);
-    Eigen::VectorXd v1(G.rows()), v2(G.rows());
-    f1.Eval(G, v1);
-    f2.Eval(G, v2);
-    EXPECT_EQ(f1.Cells(), f2.Cells());
-    EXPECT_EQ(std::memcmp(v1.data(), v2.data(), sizeof(double) * size_t(v1.size())), 0);
-}
-
-TEST(PuRbf, DuplicatedSamples)
-{
-    Points P1, N1, Q, unused;
-    test::SpherePoints(3000, 1.0, P1, N1);
-    Points P(3 * P1.rows(), 3), N(3 * P1.rows(), 3);  // every sample three times
-    P << P1, P1, P1;
-    N << N1, N1, N1;
-    test::SpherePoints(2001, 1.0, Q, unused);
-    const PuRbf f(P, N);
-    const Accuracy a = Measure(f, Q, Sphere(1.0), std::sqrt(4 * M_PI / P1.rows()));
-    Print("sphere, each sample x3", a);
-    EXPECT_LT(a.max_abs, 0.05);
-    EXPECT_EQ(a.wrong_sign, 0);
-    EXPECT_TRUE(AllFiniteOnGrid(f, P));
-}
-
-TEST(PuRbf, PileOfIdenticalSamplesDoesNotBlowUp)
-{
-    Points P1, N1;
-    test::SpherePoints(1000, 1.0, P1, N1);
-    Points P(P1.rows() + 2000, 3), N(P1.rows() + 2000, 3);
-    P.topRows(P1.rows()) = P1;
-    N.topRows(P1.rows()) = N1;
-    for (Eigen::Index i = P1.rows(); i < P.rows(); ++i) {  // 2000 copies of the north pole
-        P.row(i) << 0, 0, 1;
-        N.row(i) << 0, 0, 1;
-    }
-    const PuRbf f(P, N);
-    EXPECT_TRUE(AllFiniteOnGrid(f, P));
-    Points q(2, 3);
-    q << 0, 0, 0.9, 0, 0, 1.1;
-    Eigen::VectorXd v(2);
-    f.Eval(q, v);
-    EXPECT_LT(v[0], 0);
-    EXPECT_GT(v[1], 0);
-}
-
 TEST(PuRbf, FlatPatchIsTheSignedDistanceToItsPlane)
 {
     const int m = 60;
@@ -416,84 +220,6 @@ TEST(PuRbf, FlatPatchIsTheSignedDistanceToItsPlane)
     std::printf("[ PU-RBF   ] flat patch: max |f - signed distance| %.2e spacings\n", worst / h);
     EXPECT_LT(worst, 1e-3 * h);
     EXPECT_TRUE(AllFiniteOnGrid(f, P));
-}
-
-TEST(PuRbf, TwoFarApartClusters)
-{
-    Points A, NA;
-    test::SpherePoints(1500, 1.0, A, NA);
-    Points P(2 * A.rows(), 3), N(2 * A.rows(), 3);
-    P << A.rowwise() - Eigen::RowVector3d(50, 0, 0), A.rowwise() + Eigen::RowVector3d(50, 0, 0);
-    N << NA, NA;
-    const PuRbf f(P, N);
-    Points q(5, 3);
-    q << -50, 0, 0,  50, 0, 0,  0, 0, 0,  -50, 0, 1.2,  50, 0, -0.8;
-    Eigen::VectorXd v(5);
-    f.Eval(q, v);
-    EXPECT_LT(v[0], 0);  // the centres
-    EXPECT_LT(v[1], 0);
-    EXPECT_GT(v[2], 0);  // half-way: the far field, outside
-    EXPECT_NEAR(v[3], 0.2, 0.04);  // ~2 spacings off the surface
-    EXPECT_NEAR(v[4], -0.2, 0.04);
-    EXPECT_TRUE(AllFiniteOnGrid(f, P));
-}
-
-TEST(PuRbf, FewerSamplesThanTheMinimum)
-{
-    Points P, N;
-    test::SpherePoints(20, 1.0, P, N);
-    const PuRbf f(P, N);
-    EXPECT_EQ(f.Cells(), 1);
-    Points q(3, 3);
-    q << 0, 0, 0,  0, 0, 2,  3, 3, 3;
-    Eigen::VectorXd v(3);
-    f.Eval(q, v);
-    EXPECT_LT(v[0], 0);
-    EXPECT_GT(v[1], 0);
-    EXPECT_GT(v[2], 0);
-    EXPECT_TRUE(AllFiniteOnGrid(f, P));
-
-    // Down to two samples: still a defined function.
-    const PuRbf two(P.topRows(2), N.topRows(2));
-    EXPECT_TRUE(AllFiniteOnGrid(two, P.topRows(2)));
-}
-
-TEST(PuRbf, RejectsImpossibleInput)
-{
-    Points P, N;
-    test::SpherePoints(100, 1.0, P, N);
-    EXPECT_THROW(PuRbf(Points(0, 3), Points(0, 3)), std::invalid_argument);
-    EXPECT_THROW(PuRbf(P, N.topRows(50)), std::invalid_argument);
-    Points same = Points::Ones(30, 3);
-    EXPECT_THROW(PuRbf(same, N.topRows(30)), std::invalid_argument);
-    PuRbf::Param bad;
-    bad.overlap = 0.5;
-    EXPECT_THROW(PuRbf(P, N, bad), std::invalid_argument);
-    P(3, 1) = std::nan("");
-    EXPECT_THROW(PuRbf(P, N), std::invalid_argument);
-}
-
-namespace {
-std::vector<int> progress;
-bool Record(const int pos, const char*)
-{
-    progress.push_back(pos);
-    return true;
-}
-} // namespace
-
-TEST(PuRbf, ProgressIsMonotoneFromZeroToHundred)
-{
-    Points P, N;
-    test::SpherePoints(20000, 1.0, P, N);
-    progress.clear();
-    PuRbf::Param p;
-    p.threads = 2;
-    const PuRbf f(P, N, p, &Record);
-    ASSERT_GE(progress.size(), 5u);
-    EXPECT_EQ(progress.front(), 0);
-    EXPECT_EQ(progress.back(), 100);
-    EXPECT_TRUE(std::is_sorted(progress.begin(), progress.end()));
 }
 
 TEST(PuRbf, MarchingCubesExtractsTheSphere)
@@ -559,85 +285,4 @@ TEST(PuRbf, MarchingCubesExtractsTheNoisyTorusWithoutSpuriousSheets)
     EXPECT_EQ(t.non_manifold_edges, 0);
     EXPECT_TRUE(t.oriented);
     EXPECT_EQ(m.vn - (3 * m.fn) / 2 + m.fn, 0);  // Euler characteristic of a torus
-}
-
-// Not a test of speed (nothing asserted on time): prints fit and evaluation cost next to
-// HoppeDistance's, on ~35k samples, for the benchmark notes.
-TEST(PuRbf, SpeedReport)
-{
-    Points P, N;
-    TorusPoints(112, 1.0, 0.35, P, N);  // ~36k samples
-    AddNoise(P, 0.001);
-    using Clock = std::chrono::steady_clock;
-    auto seconds = [](Clock::time_point a) { return std::chrono::duration<double>(Clock::now() - a).count(); };
-    // Queries: a shell of lattice corners near the surface, as marching cubes would ask.
-    Points Q = OnSurface(GridAround(P, 80), Torus(1.0, 0.35));
-    Q += 0.02 * Points::Random(Q.rows(), 3);
-    Eigen::VectorXd v(Q.rows());
-    for (int threads : {1, 2}) {
-        PuRbf::Param p;
-        p.threads = threads;
-        auto t0 = Clock::now();
-        const PuRbf f(P, N, p);
-        const double fit = seconds(t0);
-        t0 = Clock::now();
-        f.Eval(Q, v);
-        const double eval = seconds(t0);
-        EXPECT_TRUE(v.allFinite());
-
-        t0 = Clock::now();
-        const SampleIndex index(P);
-        const HoppeDistance h(index, N, 8, threads);
-        const double hfit = seconds(t0);
-        t0 = Clock::now();
-        h.Eval(Q, v);
-        const double heval = seconds(t0);
-        const auto& s = f.Statistics();
-        std::printf("[ PU-RBF   ] %ld samples, %d thread(s): PU-RBF fit %.3f s (%d cells, %.0f centres/cell, %zu of %zu "
-                    "off-surface points dropped), eval %.3f us/query (wall); Hoppe index %.3f s, eval %.3f us/query (%ld queries)\n",
-                    long(P.rows()), threads, fit, s.cells, double(s.centres) / s.cells, s.off_surface_dropped,
-                    s.off_surface_points + s.off_surface_dropped, 1e6 * eval / Q.rows(), hfit, 1e6 * heval / Q.rows(),
-                    long(Q.rows()));
-    }
-}
-
-TEST(PuRbf, TwoOverlappingSheetsWithTheirOwnSpacingGiveOneZeroCrossing)
-{
-    // Two scans of the plane z = 0, each a jittered grid of spacing h, the second 0.6 h higher
-    // (a registration error). Merged, the samples are twice as dense: off-surface points one
-    // merged spacing out land next to the other sheet. With each scan's own spacing they clear
-    // it, and every vertical line crosses zero once, between the sheets.
-    const double h = 0.05, lift = 0.6 * h;
-    std::mt19937 rng(7);
-    std::uniform_real_distribution<double> jitter(-0.2 * h, 0.2 * h);
-    std::vector<Eigen::Vector3d> ps;
-    for (int sheet = 0; sheet < 2; ++sheet)
-        for (int i = 0; i < 40; ++i)
-            for (int j = 0; j < 40; ++j)
-                ps.emplace_back((i + 0.5 * sheet) * h + jitter(rng), (j + 0.5 * sheet) * h + jitter(rng), sheet * lift);
-    Points P(Eigen::Index(ps.size()), 3);
-    for (size_t i = 0; i < ps.size(); ++i)
-        P.row(Eigen::Index(i)) = ps[i];
-    const Points N = Points::Zero(P.rows(), 3).rowwise() + Eigen::RowVector3d(0, 0, 1);
-    PuRbf::Param own;
-    own.spacing = Eigen::VectorXd::Constant(P.rows(), h);
-    const PuRbf f(P, N, own);
-    EXPECT_DOUBLE_EQ(f.Statistics().median_spacing, h);
-    int lines = 0, single = 0;
-    for (double x = 0.5; x < 1.5; x += 0.1)
-        for (double y = 0.5; y < 1.5; y += 0.1, ++lines) {
-            Points Q(81, 3);
-            for (int k = 0; k < 81; ++k)
-                Q.row(k) << x, y, -2 * h + 4 * h * k / 80.0;
-            Eigen::VectorXd v(81);
-            f.Eval(Q, v);
-            int crossings = 0;
-            for (int k = 1; k < 81; ++k)
-                crossings += (v[k - 1] < 0) != (v[k] < 0);
-            single += crossings == 1 && v[0] < 0 && v[80] > 0;
-        }
-    EXPECT_EQ(single, lines);
-    PuRbf::Param wrong;
-    wrong.spacing = Eigen::VectorXd::Constant(10, h);
-    EXPECT_THROW(PuRbf(P, N, wrong), std::invalid_argument);
 }
