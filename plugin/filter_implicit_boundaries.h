@@ -1,8 +1,9 @@
 #ifndef FILTER_IMPLICIT_BOUNDARIES_H
 #define FILTER_IMPLICIT_BOUNDARIES_H
 
-// MeshLab glue of "Implicit reconstruction with boundaries": parameters, layers, result
-// dictionary and log. The algorithm lives in core/ (no Qt, no MeshLab).
+// MeshLab glue of "Implicit reconstruction with boundaries": the plugin, its result dictionary
+// and log; the parameters are in filter_parameters.cpp, reading the layers in input_layers.cpp.
+// The algorithm lives in core/ (no Qt, no MeshLab).
 
 #include <common/plugins/interfaces/filter_plugin.h>
 

@@ -1,0 +1,176 @@
+// The filter's parameter list: names, labels, tooltips and defaults, in the dialog's order.
+
+#include "filter_implicit_boundaries.h"
+#include "filter_parameters.h"
+
+#include "core/reconstruct.h"
+
+namespace ib_plugin {
+
+const QStringList kNormalSources = {"Use layer normals", "Estimate", "Estimate, facing the viewpoint"};
+const QStringList kOccupancies = {"Tangent disks", "Sample cells (paper)"};
+const QStringList kImplicits = {"PU-RBF (paper)", "Hoppe signed distance", "Mesh layer (signed distance)"};
+const QStringList kExtractions = {"SODS-driven", "Full lattice, gated", "Plain marching cubes"};
+
+} // namespace ib_plugin
+
+namespace {
+
+/// The layer offered as the implicit mesh: the most recent layer with faces other than the
+/// current one (the output of Screened Poisson run on the points), else the current one.
+unsigned int defaultImplicitMesh(const MeshDocument& md)
+{
+	unsigned int id = md.mm() ? md.mm()->id() : 0;
+	for (const MeshModel& m : md.meshIterator())
+		if (m.cm.fn > 0 && &m != md.mm())
+			id = m.id();
+	return id;
+}
+
+} // namespace
+
+using ib_plugin::kExtractions;
+using ib_plugin::kImplicits;
+using ib_plugin::kNormalSources;
+using ib_plugin::kOccupancies;
+
+RichParameterList FilterImplicitBoundariesPlugin::reconstructionParameters(const MeshDocument& md) const
+{
+	const ib::Reconstruction::Param d;
+	RichParameterList par;
+	par.addParam(RichInt(
+		"resolution", d.resolution, "Resolution (cells, 0 = automatic)",
+		QString("Marching cubes cells along the longest side of the bounding box; the SODS uses the "
+				"same lattice. 0 chooses it from the sample spacing (a cell of 0.6 times the typical "
+				"distance between neighbouring samples) and logs the value. Raise it for more detail "
+				"and tighter boundaries; lower it to close more undersampled gaps and run faster. "
+				"Allowed: 0 or %1..%2.")
+			.arg(ib::Reconstruction::kMinResolution)
+			.arg(ib::Reconstruction::kMaxResolution)));
+	par.addParam(RichEnum(
+		"implicit", int(d.implicit), kImplicits, "Implicit function",
+		"The implicit surface that is extracted. 'PU-RBF (paper)': local radial basis functions "
+		"fitted to the samples and their normals in overlapping octree cells, blended by a "
+		"partition of unity (Tobor et al. 2006): smooth and close to the samples. 'Hoppe signed "
+		"distance': blended distance to the nearest samples' tangent planes (Hoppe et al. 1992): "
+		"no fitting, follows noise more closely. 'Mesh layer (signed distance)': the closed mesh "
+		"chosen below, e.g. the output of Screened Poisson, gets the scan's real boundaries."));
+	par.addParam(RichMesh(
+		"implicit_mesh", defaultImplicitMesh(md), &md, "Implicit mesh layer",
+		"With 'Mesh layer (signed distance)': the closed triangle mesh whose surface is extracted "
+		"where the point layer has samples (run Screened Poisson on the points first). Ignored "
+		"by the other implicit functions."));
+	par.addParam(RichInt(
+		"rbf_min_samples", d.rbf.min_samples, "PU-RBF: min samples per cell",
+		"Each local RBF sees at least this many samples (its support grows where the scan is "
+		"sparse). Raise it for noisy scans (smoother), lower it for fine detail.",
+		true));
+	par.addParam(RichInt(
+		"rbf_max_samples", d.rbf.max_samples, "PU-RBF: max samples per cell",
+		"Octree cells holding more samples are split. Larger cells fit slower but smoother.",
+		true));
+	par.addParam(RichFloat(
+		"rbf_overlap", d.rbf.overlap, "PU-RBF: overlap",
+		"Support box side over cell side: how far neighbouring local functions overlap and "
+		"blend. 1 = no overlap (seams); raise it if the surface shows ridges between cells.",
+		true));
+	par.addParam(RichFloat(
+		"rbf_off_surface", d.rbf.off_surface, "PU-RBF: off-surface distance (spacings)",
+		"Distance along the normals of the off-surface constraints (+e outside, -e inside), in "
+		"local sample spacings. Lower it for thin parts whose sides are closer than two spacings.",
+		true));
+	par.addParam(RichEnum(
+		"sods_occupancy", int(d.occupancy), kOccupancies, "SODS occupancy",
+		"Which lattice cells the samples mark in the spatial occupancy data structure (SODS); "
+		"the surface is only extracted in marked cells. 'Tangent disks': each sample marks the "
+		"cells crossed by a disk in its tangent plane whose radius follows the local sample "
+		"spacing, so sparse regions stay covered while real holes stay open. 'Sample cells "
+		"(paper)': the cell holding each sample, meant to be used with a dilation of 1."));
+	par.addParam(RichFloat(
+		"sample_radius", d.sample_radius, "Tangent disk radius (spacings)",
+		"Radius of each sample's tangent disk, in units of the local sample spacing (distance "
+		"between neighbouring samples). Raise it if the result has small spurious holes where "
+		"the scan is sparse; lower it to keep narrow real holes open.",
+		true));
+	par.addParam(RichInt(
+		"sods_dilation", d.sods_dilation, "SODS dilation (rings)",
+		"Rings of 26-neighbour cells added around the marked cells. 0 suits tangent disks; the "
+		"paper uses 1 with sample cells. Raise it if the result has spurious small holes (noisy "
+		"scans); each ring extends the surface by about one cell across real boundaries and "
+		"closes holes narrower than two cells.",
+		true));
+	par.addParam(RichInt(
+		"min_boundary_edges", d.min_boundary_edges, "Min boundary edges",
+		"A hole whose boundary loop has fewer edges is taken as undersampling and filled with "
+		"its hole triangles (the implicit surface across it); larger holes are kept as real "
+		"boundaries. 0 keeps every hole. Raise it to fill more gaps of a sparse scan; lower it "
+		"to keep small real holes. Counts grow with the resolution."));
+	par.addParam(RichInt(
+		"boundary_smoothing", d.boundary_smoothing, "Boundary smoothing (iterations)",
+		"Passes of the paper's collinearity moves along each boundary loop, after which the "
+		"boundary is put back on the implicit surface (moves that would fold a face are undone). "
+		"Marching cubes boundaries are jagged; 4 to 6 passes make them smooth. 0 = off."));
+	par.addParam(RichFloat(
+		"boundary_trim", d.boundary_trim, "Boundary trim (spacings)",
+		"Faces at the boundary farther than this many local sample spacings from every sample "
+		"are peeled off, removing the margin the occupancy adds past the scan's edge; the "
+		"boundary fit then moves the boundary out onto the last samples. Raise it if the trim "
+		"opens spurious holes in sparse regions; 0 = no trim.",
+		true));
+	par.addParam(RichBool(
+		"boundary_fit", d.boundary_fit, "Fit boundary to the samples' edge",
+		"Moves each boundary vertex along the surface onto the outermost samples beside it, so "
+		"the boundary follows the scan's edge instead of the lattice's cells (measured: the "
+		"boundary distance to the true one drops by a third). Turn it off to see the boundary "
+		"the trim leaves.",
+		true));
+	par.addParam(RichBool(
+		"merge_visible_layers", false, "Merge visible layers",
+		"Reconstruct one surface from the vertices of every visible layer, each through its own "
+		"transformation matrix: several range scans aligned with the Align tool. Overlapping scans "
+		"are averaged by the implicit function. Off: the current layer only."));
+	par.addParam(RichBool(
+		"hole_layer", false, "Hole triangles in their own layer",
+		"Also add a layer '<input> holes' with the triangles that close the kept holes: showing "
+		"both layers gives the closed surface, hiding it the surface with boundaries."));
+	par.addParam(RichBool(
+		"outlier_layer", false, "Outliers in their own layer",
+		"Also add a layer '<input> outliers' with the samples left out as outliers: samples that "
+		"no other sample has among its 8 nearest (stray points off the surface). They never "
+		"shape the surface, the lattice or the boundaries; the log says how many there were."));
+	par.addParam(RichEnum(
+		"normals", int(d.normals), kNormalSources, "Normals",
+		"Where the oriented normals that define inside and outside come from. 'Use layer normals' "
+		"takes the layer's own (a scan's normals are usually best), estimates the zero or NaN ones "
+		"among them facing the way their neighbours face, and all of them when the layer has none; 'Estimate' always fits them (PCA over neighbours). "
+		"Estimated normals of each layer face its camera when it has one (a scan imported with its "
+		"scanner's position), else follow its triangles when it has faces (a range grid faces its "
+		"scanner), else, with 'Estimate, facing the viewpoint', face the viewpoint below; the rest "
+		"are oriented by propagation, which can flip whole regions of a thin or sparse scan (the "
+		"surface then comes out inside-out there, with a seam of boundary where the flipped region "
+		"meets the rest). The log says when and how normals were estimated."));
+	par.addParam(RichPosition(
+		"viewpoint", Point3m(0, 0, 0), "Viewpoint",
+		"With 'Estimate, facing the viewpoint': the position the scan was taken from; every "
+		"estimated normal of a layer without camera or faces is turned to face it."));
+	par.addParam(RichEnum(
+		"extraction", int(d.extraction), kExtractions, "Extraction",
+		"'SODS-driven' evaluates the implicit function only at the corners of occupied cells "
+		"(fast, memory grows with the surface). 'Full lattice, gated' evaluates every lattice "
+		"corner first, as the paper's implementation did: same surface, slower. 'Plain marching "
+		"cubes' ignores the occupancy and extracts the whole implicit surface (closed, no "
+		"boundaries): the reference the method is compared with.",
+		true));
+	par.addParam(RichFloat(
+		"memory_limit", d.memory_limit, "Memory limit (GB, 0 = half the RAM)",
+		"A run estimated to need more memory than this is refused before it starts, with a "
+		"message, instead of exhausting the machine. 0 uses half of the physical memory. Lower "
+		"the resolution rather than raising the limit if you can.",
+		true));
+	par.addParam(RichInt(
+		"normal_neighbours", d.normal_neighbours, "Normal estimation neighbours",
+		"Samples used to fit each tangent plane when normals are estimated. Raise it for noisy "
+		"scans, lower it for thin details.",
+		true));
+	return par;
+}
