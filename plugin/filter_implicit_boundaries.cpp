@@ -169,7 +169,7 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 	p.boundary_fit = par.getBool("boundary_fit");
 	const bool holeLayer = par.getBool("hole_layer");
 	const bool outlierLayer = par.getBool("outlier_layer");
-	p.occupancy = ib::Reconstruction::Occupancy(par.getEnum("sods_occupancy"));
+	p.sods_occupancy = ib::Reconstruction::Occupancy(par.getEnum("sods_occupancy"));
 	p.sample_radius = par.getFloat("sample_radius");
 	p.extraction = ib::GatedMarchingCubes::Extraction(par.getEnum("extraction"));
 	p.implicit = ib::Reconstruction::Implicit(par.getEnum("implicit"));
@@ -306,8 +306,8 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 	log("%s extraction: %zu SODS cells, %zu hole cells%s; %zu implicit evaluations (the full "
 		"lattice has %.0f corners, the cells the surface crosses %zu).",
 		qUtf8Printable(kExtractions[int(p.extraction)]), r.sods_cells, r.hole_cells,
-		r.hole_search_capped ? " (search capped: larger holes kept open)" : "", r.evaluations,
-		r.lattice_corners, r.crossed_corners);
+		r.hole_search_capped ? " (search capped: larger holes kept open)" : "", r.implicit_evaluations,
+		r.full_lattice_evaluations, r.crossed_cell_corners);
 
 	std::map<std::string, QVariant> res;
 	res["boundary_loops"] = int(r.loops.size());
@@ -337,9 +337,9 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 	res["implicit"] = int(p.implicit);
 	res["rbf_cells"] = r.rbf_cells;
 	res["sods_cells"] = double(r.sods_cells);
-	res["implicit_evaluations"] = double(r.evaluations);
-	res["full_lattice_evaluations"] = double(r.lattice_corners);
-	res["crossed_cell_corners"] = double(r.crossed_corners);
+	res["implicit_evaluations"] = double(r.implicit_evaluations);
+	res["full_lattice_evaluations"] = double(r.full_lattice_evaluations);
+	res["crossed_cell_corners"] = double(r.crossed_cell_corners);
 	res["memory_limit_gb"] = r.memory_limit / 1e9;
 	res["memory_estimate_gb"] = r.memory_estimate / 1e9;
 	res["normals_estimated"] = r.normals_estimated;

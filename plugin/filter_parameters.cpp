@@ -80,7 +80,7 @@ RichParameterList FilterImplicitBoundariesPlugin::reconstructionParameters(const
 		"local sample spacings. Lower it for thin parts whose sides are closer than two spacings.",
 		true));
 	par.addParam(RichEnum(
-		"sods_occupancy", int(d.occupancy), kOccupancies, "SODS occupancy",
+		"sods_occupancy", int(d.sods_occupancy), kOccupancies, "SODS occupancy",
 		"Which lattice cells the samples mark in the spatial occupancy data structure (SODS); "
 		"the surface is only extracted in marked cells. 'Tangent disks': each sample marks the "
 		"cells crossed by a disk in its tangent plane whose radius follows the local sample "

@@ -69,7 +69,7 @@ public:
     struct Param
     {
         int resolution = 0;          ///< cells along the longest bbox side; 0 = from sample spacing
-        Occupancy occupancy = Occupancy::TangentDisks;
+        Occupancy sods_occupancy = Occupancy::TangentDisks;
         double sample_radius = 1.25; ///< tangent disk radius, in local sample spacings
         int sods_dilation = 0;       ///< 26-neighbourhood rings added around occupied cells
         NormalSource normals = NormalSource::LayerOrEstimate;
@@ -119,9 +119,9 @@ public:
         Index3 lattice_cells = Index3::Zero();
         int rbf_cells = 0;           ///< local RBF fits (PU-RBF only)
         size_t sods_cells = 0;
-        size_t evaluations = 0;
-        size_t crossed_corners = 0;  ///< corners of the SODS and hole cells the surface crosses
-        double lattice_corners = 0;  ///< what a full-lattice extraction would have evaluated
+        size_t implicit_evaluations = 0;  ///< lattice corners where the implicit function was evaluated
+        size_t crossed_cell_corners = 0;  ///< corners of the SODS and hole cells the surface crosses
+        double full_lattice_evaluations = 0;  ///< what a full-lattice extraction would have evaluated (corners)
         double memory_limit = 0;     ///< the budget used, bytes
         double memory_estimate = 0;  ///< the estimated peak, bytes (MemoryBudget::PeakBytes)
         bool normals_estimated = false;
@@ -209,13 +209,13 @@ private:
         // Padding keeps every SODS cell and its corners inside the lattice: the widest disk
         // (capped at the lattice size: an outlier's disk may be clipped), the dilation, one more.
         const double cell = longest / r.resolution;
-        const int diskCells = p.occupancy == Occupancy::TangentDisks
+        const int diskCells = p.sods_occupancy == Occupancy::TangentDisks
                                   ? std::min(r.resolution, int(std::ceil(p.sample_radius * spacing.maxCoeff() / cell)))
                                   : 0;
         const Lattice lattice = Lattice::Fit(lo, hi, r.resolution, p.sods_dilation + diskCells + 1);
         r.cell_size = lattice.cell_size;
         r.lattice_cells = lattice.cells;
-        r.lattice_corners = lattice.CornerCount();
+        r.full_lattice_evaluations = lattice.CornerCount();
         r.memory_limit = p.memory_limit > 0 ? p.memory_limit : MemoryBudget::Default();
         // Before the implicit function, the largest per-sample cost: a surface of n samples at
         // spacing s covers about n·s² / cell² cells, in a layer two cells thick, or as thick as
@@ -243,7 +243,7 @@ private:
         // closed the smallest real holes of bun_zipper and fertility: samples at a hole's rim
         // have one-sided neighbourhoods, so larger spacings.)
         const Eigen::VectorXd foldWidth = OrientationSeam::FoldWidths(samples, normals, spacing, p.threads, scan);
-        Sods sods = p.occupancy == Occupancy::TangentDisks
+        Sods sods = p.sods_occupancy == Occupancy::TangentDisks
                         ? Sods::FromDisks(lattice, ImplicitProjection::OntoZeroSet(P, normals, f), normals, p.sample_radius * spacing,
                                           kDiskSlack * lattice.cell_size, p.threads, 0.5 * foldWidth,
                                           kSlabPerSpacing * spacing, kCellPerSpacing * r.sample_spacing)
@@ -262,8 +262,8 @@ private:
         mp.extraction = p.extraction;
         const GatedMarchingCubes::Result mc =
             GatedMarchingCubes::Compute(lattice, sods, f, surface, mp, ProgressRange::Into(cb, 40, 96));
-        r.evaluations = mc.evaluations;
-        r.crossed_corners = mc.crossed_corners;
+        r.implicit_evaluations = mc.evaluations;
+        r.crossed_cell_corners = mc.crossed_corners;
         r.hole_cells = mc.hole_cells;
         r.hole_search_capped = mc.hole_search_capped;
         r.seconds_extraction = seconds(t);

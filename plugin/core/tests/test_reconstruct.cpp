@@ -21,7 +21,7 @@ TEST(Reconstruction, ClosedSphereHasNoBoundary)
     for (const auto& v : m.vert)
         worst = std::max(worst, std::abs(v.cP().Norm() - 1.0));
     EXPECT_LT(worst, 0.25 * r.cell_size);
-    EXPECT_LT(double(r.evaluations), 0.5 * r.lattice_corners);
+    EXPECT_LT(double(r.implicit_evaluations), 0.5 * r.full_lattice_evaluations);
 }
 
 TEST(Reconstruction, HemisphereHasExactlyOneBoundaryLoopAtItsRim)
@@ -197,8 +197,8 @@ TEST(Reconstruction, FullLatticeExtractionsMatchTheSodsDrivenOne)
     const auto rs = Reconstruction::Compute(P, N, sparse, ms);
     const auto rf = Reconstruction::Compute(P, N, full, mf);
     const auto rp = Reconstruction::Compute(P, N, plain, mp);
-    EXPECT_EQ(rf.evaluations, size_t(rf.lattice_corners));
-    EXPECT_LT(rs.evaluations, rf.evaluations / 4);
+    EXPECT_EQ(rf.implicit_evaluations, size_t(rf.full_lattice_evaluations));
+    EXPECT_LT(rs.implicit_evaluations, rf.implicit_evaluations / 4);
     ASSERT_EQ(ms.vert.size(), mf.vert.size());
     for (size_t i = 0; i < ms.vert.size(); ++i)
         ASSERT_EQ(ms.vert[i].cP(), mf.vert[i].cP()) << i;
