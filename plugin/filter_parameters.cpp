@@ -5,12 +5,58 @@
 
 #include "core/reconstruct.h"
 
+#include <utility>
+
+namespace {
+
+using R = ib::Reconstruction;
+using Extraction = ib::GatedMarchingCubes::Extraction;
+
+// Each label beside the core's enum value it stands for; the dialog's index of a label is the
+// value's integer, checked at compile time.
+template <class E>
+using Label = std::pair<E, const char*>;
+constexpr Label<R::NormalSource> kNormalSourceLabels[] = {
+	{R::NormalSource::LayerOrEstimate, "Use layer normals"}, {R::NormalSource::Estimate, "Estimate"}};
+constexpr Label<R::Occupancy> kOccupancyLabels[] = {
+	{R::Occupancy::TangentDisks, "Tangent disks"}, {R::Occupancy::SampleCells, "Sample cells (paper)"}};
+constexpr Label<R::Implicit> kImplicitLabels[] = {{R::Implicit::PuRbf, "PU-RBF (paper)"},
+												  {R::Implicit::Hoppe, "Hoppe signed distance"},
+												  {R::Implicit::Given, "Mesh layer (signed distance)"}};
+constexpr Label<Extraction> kExtractionLabels[] = {{Extraction::SodsDriven, "SODS-driven"},
+												   {Extraction::FullLatticeGated, "Full lattice, gated"},
+												   {Extraction::Plain, "Plain marching cubes"}};
+
+template <class E, size_t N>
+constexpr bool InValueOrder(const Label<E> (&labels)[N])
+{
+	for (size_t i = 0; i < N; ++i)
+		if (size_t(labels[i].first) != i)
+			return false;
+	return true;
+}
+static_assert(InValueOrder(kNormalSourceLabels) && InValueOrder(kOccupancyLabels) && InValueOrder(kImplicitLabels) &&
+				  InValueOrder(kExtractionLabels),
+			  "an enum label is not at its value's index");
+
+template <class E, size_t N>
+QStringList Labels(const Label<E> (&labels)[N])
+{
+	QStringList out;
+	for (const Label<E>& label : labels)
+		out << label.second;
+	return out;
+}
+
+} // namespace
+
 namespace ib_plugin {
 
-const QStringList kNormalSources = {"Use layer normals", "Estimate", "Estimate, facing the viewpoint"};
-const QStringList kOccupancies = {"Tangent disks", "Sample cells (paper)"};
-const QStringList kImplicits = {"PU-RBF (paper)", "Hoppe signed distance", "Mesh layer (signed distance)"};
-const QStringList kExtractions = {"SODS-driven", "Full lattice, gated", "Plain marching cubes"};
+// The third is Estimate with the viewpoint (kNormalsFacingViewpoint).
+const QStringList kNormalSources = Labels(kNormalSourceLabels) << "Estimate, facing the viewpoint";
+const QStringList kOccupancies = Labels(kOccupancyLabels);
+const QStringList kImplicits = Labels(kImplicitLabels);
+const QStringList kExtractions = Labels(kExtractionLabels);
 
 } // namespace ib_plugin
 

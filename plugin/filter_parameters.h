@@ -8,14 +8,13 @@
 
 namespace ib_plugin {
 
-// The first two match ib::Reconstruction::NormalSource; the third is Estimate with the viewpoint.
+// Each list's index i is the label of the core enum value i (checked at compile time in
+// filter_parameters.cpp): ib::Reconstruction::NormalSource (then Estimate with the viewpoint),
+// Occupancy, Implicit, and ib::GatedMarchingCubes::Extraction.
 extern const QStringList kNormalSources;
 constexpr int kNormalsFacingViewpoint = 2;
-// Order matches ib::Reconstruction::Occupancy.
 extern const QStringList kOccupancies;
-// Order matches ib::Reconstruction::Implicit.
 extern const QStringList kImplicits;
-// Order matches ib::GatedMarchingCubes::Extraction.
 extern const QStringList kExtractions;
 
 } // namespace ib_plugin
