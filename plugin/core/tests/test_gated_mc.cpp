@@ -173,35 +173,3 @@ TEST(GatedMarchingCubes, TheThreeExtractionsAgreeInSodsCells)
     ASSERT_GT(gated.size(), 100u);
     EXPECT_EQ(Triangles(plain, l, &slab), gated);
 }
-
-TEST(GatedMarchingCubes, LeanFaceFaceAdjacencyEqualsVcgs)
-{
-    // An open cap (border edges) extracted by marching cubes: every face's three neighbours
-    // are the ones vcg::tri::UpdateTopology::FaceFace finds.
-    const Lattice l = Lattice::Fit(Eigen::Vector3d(-1, -1, -1), Eigen::Vector3d(1, 1, 1), 18, 2);
-    Sods upper(l.cells);
-    test::AllCells(l).ForEach([&](const Index3& c) {
-        if (l.Corner(c[0], c[1], c[2])[2] > -0.2)
-            upper.Insert(c);
-    });
-    CoreMesh m;
-    GatedMarchingCubes::Param noHoles;
-    noHoles.holes = false;
-    GatedMarchingCubes::Compute(l, upper, test::SphereDistance(0.8), m, noHoles);
-    UpdateFaceFace(m);
-    std::vector<std::array<const CoreFace*, 3>> lean;
-    std::vector<std::array<int, 3>> leanIndex;
-    for (const auto& f : m.face) {
-        lean.push_back({f.cFFp(0), f.cFFp(1), f.cFFp(2)});
-        leanIndex.push_back({f.cFFi(0), f.cFFi(1), f.cFFi(2)});
-    }
-    vcg::tri::UpdateTopology<CoreMesh>::FaceFace(m);
-    int borders = 0;
-    for (size_t i = 0; i < m.face.size(); ++i)
-        for (int k = 0; k < 3; ++k) {
-            ASSERT_EQ(lean[i][size_t(k)], m.face[i].cFFp(k)) << i << " " << k;
-            ASSERT_EQ(leanIndex[i][size_t(k)], m.face[i].cFFi(k)) << i << " " << k;
-            borders += m.face[i].cFFp(k) == &m.face[i];
-        }
-    EXPECT_GT(borders, 20);
-}

@@ -1,4 +1,5 @@
 // Mesh helpers: vertex positions, and the lean face-face adjacency against VCGlib's.
+#include "gated_mc.h"
 #include "geometry.h"
 #include "mesh.h"
 
@@ -60,4 +61,20 @@ TEST(Mesh, LeanFaceFaceAdjacencyOnHandMadeMeshes)
     EXPECT_EQ(SameAdjacencyAsVcg(two), 4);
     UpdateFaceFace(two);
     EXPECT_EQ(two.face[0].cFFp(0), &two.face[1]);
+}
+
+TEST(Mesh, LeanFaceFaceAdjacencyOnAMarchingCubesCap)
+{
+    // An open cap (border edges) extracted by gated marching cubes, as the pipeline makes them.
+    const Lattice l = Lattice::Fit(Eigen::Vector3d(-1, -1, -1), Eigen::Vector3d(1, 1, 1), 18, 2);
+    Sods upper(l.cells);
+    test::AllCells(l).ForEach([&](const Index3& c) {
+        if (l.Corner(c[0], c[1], c[2])[2] > -0.2)
+            upper.Insert(c);
+    });
+    CoreMesh m;
+    GatedMarchingCubes::Param noHoles;
+    noHoles.holes = false;
+    GatedMarchingCubes::Compute(l, upper, test::SphereDistance(0.8), m, noHoles);
+    EXPECT_GT(SameAdjacencyAsVcg(m), 20);
 }
