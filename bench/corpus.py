@@ -9,7 +9,7 @@ clean input plus 0.1% of its sample count drawn uniformly in the bounding box wi
 normals, and one sample at ten times the diagonal; its time is over the clean run's, and the
 farthest face from the true surface is in local spacings of the nearest sample). Per mesh and
 condition: loops found / true loops, boundary distance, spurious and missing area (the
-yardsticks of README "Yardsticks": surface farther than 1% of the diagonal from the other
+yardsticks of docs/yardsticks.md: surface farther than 1% of the diagonal from the other
 surface) and our time over screened Poisson's at matched depth, in the same run. A summary per
 condition and per kind of difficulty follows.
 
