@@ -15,7 +15,6 @@
 #include "normals.h"
 #include "orientation_seam.h"
 #include "outliers.h"
-#include "pinches.h"
 #include "progress.h"
 #include "sods.h"
 #include "spacing.h"
@@ -244,8 +243,9 @@ private:
         // have one-sided neighbourhoods, so larger spacings.)
         const Eigen::VectorXd foldWidth = OrientationSeam::FoldWidths(samples, normals, spacing, p.threads, scan);
         Sods sods = p.sods_occupancy == Occupancy::TangentDisks
-                        ? Sods::FromDisks(lattice, ImplicitProjection::OntoZeroSet(P, normals, f), normals, p.sample_radius * spacing,
-                                          kDiskSlack * lattice.cell_size, p.threads, 0.5 * foldWidth,
+                        ? Sods::FromDisks(lattice, ImplicitProjection::OntoZeroSet(P, normals, f), normals,
+                                          p.sample_radius * spacing, kDiskSlack * lattice.cell_size, p.threads,
+                                          0.5 * foldWidth,
                                           kSlabPerSpacing * spacing, kCellPerSpacing * r.sample_spacing)
                         : Sods::FromSamples(lattice, P);
         for (int i = 0; i < p.sods_dilation; ++i)
