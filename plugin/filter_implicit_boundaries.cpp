@@ -51,6 +51,19 @@ QString loopSummary(const std::vector<ib::BoundaryLoop>& loops)
 	return loops.empty() ? QString("none") : sizes.join(", ");
 }
 
+/// How close the hole size decisions were, and which min_boundary_edges would change them.
+QString holeMargins(const ib::BoundaryStage::Result& b, int minEdges)
+{
+	QStringList what;
+	if (b.largest_hole_filled > 0)
+		what << QString("the largest hole filled had a loop of %1 edges (min_boundary_edges %2 or less keeps it "
+						"open)").arg(b.largest_hole_filled).arg(b.largest_hole_filled);
+	if (b.smallest_hole_kept > 0)
+		what << QString("the smallest hole kept open, %1 edges (min_boundary_edges %2 fills it)")
+					.arg(b.smallest_hole_kept).arg(b.smallest_hole_kept + 1);
+	return QString("Closest hole decisions at min_boundary_edges %1: %2.").arg(minEdges).arg(what.join("; "));
+}
+
 } // namespace
 
 FilterImplicitBoundariesPlugin::FilterImplicitBoundariesPlugin()
@@ -293,6 +306,8 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 		"boundary vertices fitted to the samples' edge.",
 		out->cm.fn, out->cm.vn, int(r.loops.size()), qUtf8Printable(loopSummary(r.loops)),
 		r.boundary.holes_filled, p.min_boundary_edges, r.boundary.faces_trimmed, r.boundary.boundary_vertices_fitted);
+	if (r.boundary.largest_hole_filled > 0 || r.boundary.smallest_hole_kept > 0)
+		log("%s", qUtf8Printable(holeMargins(r.boundary, p.min_boundary_edges)));
 	if (r.faces_not_manifold > 0 || r.vertices_split > 0)
 		log("Made the surface a 2-manifold: removed %zu faces from edges shared by more than two faces, split %zu "
 			"vertices where separate fans met.", r.faces_not_manifold, r.vertices_split);
@@ -317,6 +332,8 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 	res["boundary_loops_before_filling"] = QVariant::fromValue(toVector(
 		std::vector<double>(r.boundary.loops_before_filling.begin(), r.boundary.loops_before_filling.end())));
 	res["holes_filled"] = r.boundary.holes_filled;
+	res["largest_hole_filled_edges"] = r.boundary.largest_hole_filled;
+	res["smallest_hole_kept_edges"] = r.boundary.smallest_hole_kept;
 	res["hole_faces"] = holes.fn;
 	res["hole_cells"] = double(r.hole_cells);
 	res["faces_trimmed"] = double(r.boundary.faces_trimmed);

@@ -74,6 +74,12 @@ public:
     {
         std::vector<int> loops_before_filling;  ///< edge counts of all loops before small holes were filled
         int holes_filled = 0;             ///< hole regions added to the surface
+        /// How close the size decisions were (edges of a hole's longest loop, before filling; 0:
+        /// no such hole): the largest hole filled as undersampling, and the smallest hole the
+        /// implicit surface closes that was kept open. A min_boundary_edges above the second
+        /// fills it too; one at or below the first keeps that one open.
+        int largest_hole_filled = 0;
+        int smallest_hole_kept = 0;
         size_t faces_cut_at_seams = 0;    ///< surface faces removed around orientation seams
         size_t faces_trimmed = 0;         ///< unsupported faces peeled off the boundary
         size_t faces_unpinched = 0;       ///< faces of smaller fans removed at pinch vertices
@@ -101,7 +107,7 @@ public:
         // gap between the scans' coverage, filled whatever its loops' size.
         const std::vector<int> fill = SmallHoles(all, inSurface, mc, p.min_boundary_edges,
                                                  p.merged_scans ? &samples : nullptr, spacing, p.threads,
-                                                 r.loops_before_filling);
+                                                 r.loops_before_filling, &r);
         for (size_t face = mc.surface_faces; face < all.face.size(); ++face)
             if (fill[size_t(mc.face_region[face - mc.surface_faces])])
                 inSurface[face] = 1;
@@ -138,14 +144,15 @@ public:
     /// gap by a detour far from every sample, a torn tip whose fit bulges away, many more), and
     /// small: every loop along it has fewer than `min_edges` edges, or, with `coverage` (the
     /// samples of merged scans, their local `spacing`; null: no such rule), none of it is
-    /// farther than kCoverageGap spacings from them. Also reports the edge counts of all loops.
+    /// farther than kCoverageGap spacings from them. Also reports the edge counts of all loops
+    /// and, in `margins` (may be null), largest_hole_filled and smallest_hole_kept.
     static std::vector<int> SmallHoles(const CoreMesh& all, const std::vector<char>& inSurface,
                                        const GatedMarchingCubes::Result& mc, int min_edges,
                                        const SampleIndex* coverage, const Eigen::VectorXd& spacing, int threads,
-                                       std::vector<int>& loopEdges)
+                                       std::vector<int>& loopEdges, Result* margins = nullptr)
     {
         std::vector<int> fill(mc.region_closed.begin(), mc.region_closed.end());
-        std::vector<double> edges(fill.size(), 0), faces(fill.size(), 0);
+        std::vector<double> edges(fill.size(), 0), faces(fill.size(), 0), longest(fill.size(), 0);
         std::vector<char> large(fill.size(), 0);
         for (int region : mc.face_region)
             ++faces[size_t(region)];
@@ -159,6 +166,7 @@ public:
             regions.erase(std::unique(regions.begin(), regions.end()), regions.end());
             for (size_t region : regions) {
                 edges[region] += loop.Edges();
+                longest[region] = std::max(longest[region], double(loop.Edges()));
                 large[region] |= char(loop.Edges() >= min_edges);
             }
         }
@@ -173,6 +181,12 @@ public:
             const std::vector<double> depth = RegionDepths(all, mc, candidate, *coverage, spacing, threads);
             for (size_t i = 0; i < fill.size(); ++i)
                 fill[i] = fill[i] || (candidate[i] && depth[i] <= kCoverageGap);
+        }
+        for (size_t i = 0; margins && i < fill.size(); ++i) {
+            if (fill[i] && !candidate[i])
+                margins->largest_hole_filled = std::max(margins->largest_hole_filled, int(longest[i]));
+            if (candidate[i] && !fill[i] && (!margins->smallest_hole_kept || longest[i] < margins->smallest_hole_kept))
+                margins->smallest_hole_kept = int(longest[i]);
         }
         return fill;
     }
