@@ -178,6 +178,7 @@ def main(argv=None):
     p.add_argument("--cases", nargs="+", default=list(CASES), help="paths under --data")
     p.add_argument("--conditions", nargs="+", default=CONDITIONS, choices=CONDITIONS)
     p.add_argument("--params", nargs="*", help="filter parameters, name=value")
+    p.add_argument("--seed", type=int, default=0, help="another draw of the noise and the outliers")
     args = p.parse_args(argv)
     params = parse_params(args.params)
     implicit_boundaries.load()
@@ -190,7 +191,7 @@ def main(argv=None):
         points, normals, faces = load_case(args.data / name)
         clean_seconds = None
         for condition in args.conditions:
-            rng = np.random.default_rng(len(points))  # the same noise in every run
+            rng = np.random.default_rng(len(points) + args.seed)  # the same noise in every run
             row = measure(name, condition, points, normals, faces, rng, params, clean_seconds)
             if condition == "clean":
                 clean_seconds = row["seconds"]

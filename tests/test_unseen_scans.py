@@ -96,12 +96,18 @@ def test_strays_in_the_empty_space_around_a_scan_are_left_out(plugin, seed):
     assert rec.loops == []
 
 
-def test_a_thin_plate_three_spacings_thick_stays_closed():
+@pytest.mark.parametrize("fits", [
+    pytest.param({}, marks=pytest.mark.xfail(strict=True, reason=(
+        "the default fits of 20-60 samples tear the rim over a fifth of its length (one loop of "
+        "170 edges; BENCHMARKS.md, 'Smaller local fits by default')"))),
+    dict(rbf_min_samples=50, rbf_max_samples=160),  # the paper's
+], ids=["default fits", "the paper's fits"])
+def test_a_thin_plate_three_spacings_thick_stays_closed(fits):
     """A closed plate whose sides are 3 sample spacings apart (an ear, a fin), exact normals: no
     loop. Its rim was cut as an orientation seam (opposite normals in each other's tangent
     planes) and gated out (the surface turns there between the sides' flat disks): 8 loops."""
     points, normals = shapes.thin_plate(3)
-    rec = implicit_boundaries.reconstruct(points, normals)
+    rec = implicit_boundaries.reconstruct(points, normals, **fits)
     assert len(rec.loops) == 0 and rec.info["seam_points"] == 0
     _, nearest = cKDTree(points).query(rec.vertices)
     assert nearest.size and np.max(np.linalg.norm(rec.vertices - points[nearest], axis=1)) < 2 * rec.info["sample_spacing"]

@@ -63,6 +63,15 @@ public:
             spacing(unmeasured) = Local(samples, 1, threads)(unmeasured);
         return spacing;
     }
+
+    /// How many sheets of samples overlap where scans are merged: (the median of `perScan`,
+    /// PerScan's spacings, / the median spacing among all samples)^2, at least 1 (1 for one
+    /// scan; the 9 Stanford bunny scans: 2.4).
+    static double Overlap(const SampleIndex& samples, const Eigen::VectorXd& perScan, int threads)
+    {
+        const double merged = Median(Local(samples, 1, threads));
+        return merged > 0 ? std::max(1.0, std::pow(Median(perScan) / merged, 2)) : 1.0;
+    }
 };
 
 } // namespace ib

@@ -1,9 +1,10 @@
-// Sample spacing: exact on regular grids, the median, and per scan of merged scans.
+// Sample spacing: exact on regular grids, the median, per scan of merged scans and their overlap.
 #include "spacing.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 #include <vector>
 
 using namespace ib;
@@ -104,4 +105,26 @@ TEST(SampleSpacing, PerScanMeasuresEachScanAmongItsOwnSamples)
         EXPECT_EQ(own[i], all[i]);
     // One scan: the spacing among all samples.
     EXPECT_EQ(SampleSpacing::PerScan(samples, {}, 1), all);
+}
+
+TEST(SampleSpacing, OverlapCountsTheSheetsOfMergedScans)
+{
+    // Three scans of one unit square, 2,500 random samples each, lifted a registration error
+    // apart: three sheets, three times the density.
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> u(0, 1);
+    std::vector<Eigen::RowVector3d> ps;
+    std::vector<int> scan;
+    for (int s = 0; s < 3; ++s)
+        for (int i = 0; i < 2500; ++i) {
+            ps.emplace_back(u(rng), u(rng), 0.002 * s);
+            scan.push_back(s);
+        }
+    const Points P = Stack(ps);  // SampleIndex refers to it
+    const SampleIndex samples(P);
+    EXPECT_NEAR(SampleSpacing::Overlap(samples, SampleSpacing::PerScan(samples, scan, 2), 2), 3.0, 0.3);
+    // One scan: no overlap, and never below 1.
+    const Points single = Stack(Grid(30, 0.02, 0));
+    const SampleIndex one(single);
+    EXPECT_DOUBLE_EQ(SampleSpacing::Overlap(one, SampleSpacing::Local(one), 1), 1.0);
 }
