@@ -109,6 +109,26 @@ def wavy_cap(n, seed=0):
     return u * (1 + wave)[:, None], normals / np.linalg.norm(normals, axis=1, keepdims=True)
 
 
+def overlapping_caps(seed, shift_spacings=0.8, n=5000):
+    """An open cap (the unit sphere above z = -0.5) scanned from four sides, in a new MeshSet:
+    one layer per scan, a hemisphere of a jittered Fibonacci sphere of n points seen from its
+    side, with exact normals, and a matrix that shifts it by shift_spacings of a scan's spacing
+    in a random direction (the registration error the Align tool leaves). Returns the MeshSet
+    and the spacing within a scan."""
+    rng = np.random.default_rng(seed)
+    spacing = np.sqrt(4 * np.pi / n)
+    ms = pymeshlab.MeshSet()
+    for i, side in enumerate([[1, 0, 0.3], [-0.5, 0.87, 0.3], [-0.5, -0.87, 0.3], [0, 0, 1]]):
+        u = fibonacci_sphere(n, jitter=0.3, rng=rng)
+        u = u[(u[:, 2] > -0.5) & (u @ side > 0)]
+        shift = rng.normal(size=3)
+        matrix = np.eye(4)
+        matrix[:3, 3] = shift_spacings * spacing * shift / np.linalg.norm(shift)
+        ms.add_mesh(pymeshlab.Mesh(vertex_matrix=u, v_normals_matrix=u), f"scan {i}")
+        ms.set_matrix(transformmatrix=matrix, freeze=False)
+    return ms, spacing
+
+
 def thin_plate(thickness_spacings=1.5, spacing=0.02, seed=0):
     """A closed plate (a flattened ellipsoid with semi-axes 1, 0.6 and half the thickness)
     whose two sides are `thickness_spacings` sample spacings apart: an ear or a fin. Samples

@@ -7,7 +7,7 @@ import pytest
 
 import implicit_boundaries
 from implicit_boundaries.options import Normals
-from shapes import fibonacci_sphere
+from shapes import fibonacci_sphere, overlapping_caps
 
 
 def open_scan():
@@ -104,17 +104,7 @@ def test_overlapping_scans_with_registration_error_give_one_sheet(plugin, seed):
     density grows but the detail does not: the spacing is measured within each scan, and the
     surface is one sheet with the cap's one loop (measured over all samples, the sheets lay
     apart by more than a spacing and tore: 4 and 12 loops)."""
-    rng = np.random.default_rng(seed)
-    spacing = np.sqrt(4 * np.pi / 5000)
-    ms = pymeshlab.MeshSet()
-    for i, side in enumerate([[1, 0, 0.3], [-0.5, 0.87, 0.3], [-0.5, -0.87, 0.3], [0, 0, 1]]):
-        u = fibonacci_sphere(5000, jitter=0.3, rng=rng)
-        u = u[(u[:, 2] > -0.5) & (u @ side > 0)]
-        shift = rng.normal(size=3)
-        matrix = np.eye(4)
-        matrix[:3, 3] = 0.8 * spacing * shift / np.linalg.norm(shift)
-        ms.add_mesh(pymeshlab.Mesh(vertex_matrix=u, v_normals_matrix=u), f"scan {i}")
-        ms.set_matrix(transformmatrix=matrix, freeze=False)
+    ms, spacing = overlapping_caps(seed, shift_spacings=0.8)
     out = implicit_boundaries.apply(ms, merge_visible_layers=True)
     assert out["boundary_loops"] == 1
     assert abs(out["sample_spacing"] - spacing) < 0.2 * spacing
