@@ -229,7 +229,7 @@ private:
                                      std::max(2.0, 2 * kSlabPerSpacing * r.sample_spacing / cell);
         r.memory_estimate = CheckMemory(p, lattice, double(input.rows()), expectedCells, r);
         const std::unique_ptr<ImplicitFunction> fitted =
-            p.implicit == Implicit::Given ? nullptr : MakeImplicit(P, normals, samples, spacing, p, cb);
+            p.implicit == Implicit::Given ? nullptr : MakeImplicit(normals, samples, spacing, p, cb);
         const ImplicitFunction& f = fitted ? *fitted : *p.given;
         if (const auto* rbf = dynamic_cast<const PuRbf*>(fitted.get()))
             r.rbf_cells = rbf->Cells();
@@ -301,9 +301,9 @@ private:
         return r;
     }
 
-    /// The implicit function p asks for, fitted to the samples P with unit normals N and local
-    /// `spacing` (within each sample's own scan).
-    static std::unique_ptr<ImplicitFunction> MakeImplicit(const Points& P, const Points& N, const SampleIndex& samples,
+    /// The implicit function p asks for, fitted to the samples (sharing their k-d tree) with
+    /// unit normals N and local `spacing` (within each sample's own scan).
+    static std::unique_ptr<ImplicitFunction> MakeImplicit(const Points& N, const SampleIndex& samples,
                                                           const Eigen::VectorXd& spacing, const Param& p,
                                                           vcg::CallBackPos* cb)
     {
@@ -320,7 +320,7 @@ private:
             rp.max_samples = std::min(5000, int(std::lround(overlap * rp.max_samples)));
         }
         try {
-            return std::make_unique<PuRbf>(P, N, rp, ProgressRange::Into(cb, 5, 35));
+            return std::make_unique<PuRbf>(samples, N, rp, ProgressRange::Into(cb, 5, 35));
         } catch (const std::invalid_argument& e) {
             throw InputError(e.what());
         }

@@ -60,6 +60,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -114,35 +115,21 @@ public:
     /// sparse spacings off on the tests' half-sparse sphere, instead of 0.03).
     static constexpr size_t kSplitFactor = 3;
 
-    /// P, N: n×3 samples and unit outward normals (rows). Both are copied. Fits all local
-    /// functions; cb (may be null) goes from 0 to 100. Throws std::invalid_argument for no
-    /// samples, mismatched shapes, non-finite positions, samples that all coincide, or
-    /// parameters out of range.
+    /// P, N: n×3 samples and unit outward normals (rows). Both are copied, and P gets its own
+    /// k-d tree. Fits all local functions; cb (may be null) goes from 0 to 100. Throws
+    /// std::invalid_argument for no samples, mismatched shapes, non-finite positions, samples
+    /// that all coincide, or parameters out of range.
     PuRbf(const Points& P, const Points& N, const Param& param, vcg::CallBackPos* cb = nullptr)
-        : P_(Check(P, N)), N_(Normalised(N)), index_(P_), param_(param)
+        : PuRbf(std::make_unique<Owned>(Check(P, N)), nullptr, N, param, cb)
     {
-        if (!(param.min_samples >= 1 && param.max_samples >= 1 && param.overlap >= 1 && param.off_surface > 0 &&
-              param.max_fit_samples >= 1 && param.max_centres >= 1))
-            throw std::invalid_argument("PuRbf: min_samples, max_samples, max_fit_samples and max_centres must be "
-                                        ">= 1, overlap >= 1 and off_surface > 0");
-        if (param.spacing.size() != 0 && param.spacing.size() != P.rows())
-            throw std::invalid_argument("PuRbf: one spacing per sample, or none");
-        const auto start = std::chrono::steady_clock::now();
-        auto progress = [&](int percent, const char* what) { if (cb) cb(percent, what); };
-        progress(0, "PU-RBF: octree");
-        PointOctree::Param octree;
-        octree.max_samples = param.max_samples;
-        octree.overlap = param.overlap;
-        octree.max_support_samples = kSplitFactor * size_t(param.max_fit_samples);
-        octree_ = PointOctree(P_, octree);
-        std::vector<PointOctree::Box> boxes = LeafBoxes();
-        progress(5, "PU-RBF: off-surface points");
-        OffSurfacePoints();
-        progress(10, "PU-RBF: fitting local functions");
-        Fit(boxes, cb);
-        Bound();
-        stats_.fit_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        progress(100, "PU-RBF: done");
+    }
+
+    /// The same over the samples of `samples` and their k-d tree, shared, not copied (they must
+    /// outlive this function): a large scan's positions and tree are the biggest per-sample
+    /// parts of the run's memory after the lattice.
+    PuRbf(const SampleIndex& samples, const Points& N, const Param& param, vcg::CallBackPos* cb = nullptr)
+        : PuRbf(nullptr, &samples, (Check(samples.P(), N), N), param, cb)
+    {
     }
 
     /// With the default Param.
@@ -164,6 +151,43 @@ public:
     double FitSeconds() const { return stats_.fit_seconds; }
 
 private:
+    /// The samples' own copy and k-d tree, when they are not shared.
+    struct Owned
+    {
+        explicit Owned(const Points& P) : P(P), index(this->P) {}
+        Points P;
+        SampleIndex index;
+    };
+
+    PuRbf(std::unique_ptr<Owned> owned, const SampleIndex* shared, const Points& N, const Param& param,
+          vcg::CallBackPos* cb)
+        : owned_(std::move(owned)), index_(owned_ ? owned_->index : *shared), P_(index_.P()), N_(Normalised(N)),
+          param_(param)
+    {
+        if (!(param.min_samples >= 1 && param.max_samples >= 1 && param.overlap >= 1 && param.off_surface > 0 &&
+              param.max_fit_samples >= 1 && param.max_centres >= 1))
+            throw std::invalid_argument("PuRbf: min_samples, max_samples, max_fit_samples and max_centres must be "
+                                        ">= 1, overlap >= 1 and off_surface > 0");
+        if (param.spacing.size() != 0 && param.spacing.size() != P_.rows())
+            throw std::invalid_argument("PuRbf: one spacing per sample, or none");
+        const auto start = std::chrono::steady_clock::now();
+        auto progress = [&](int percent, const char* what) { if (cb) cb(percent, what); };
+        progress(0, "PU-RBF: octree");
+        PointOctree::Param octree;
+        octree.max_samples = param.max_samples;
+        octree.overlap = param.overlap;
+        octree.max_support_samples = kSplitFactor * size_t(param.max_fit_samples);
+        octree_ = PointOctree(P_, octree);
+        std::vector<PointOctree::Box> boxes = LeafBoxes();
+        progress(5, "PU-RBF: off-surface points");
+        OffSurfacePoints();
+        progress(10, "PU-RBF: fitting local functions");
+        Fit(boxes, cb);
+        Bound();
+        stats_.fit_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        progress(100, "PU-RBF: done");
+    }
+
     /// A node of the tree the blend descends: an octree node with the bounds of the support
     /// boxes below it, so a query skips the subtrees whose boxes all miss it.
     struct BoxNode
@@ -384,8 +408,10 @@ private:
         return (sum + (kCoverage - weights) * plane) / kCoverage;
     }
 
-    Points P_, N_;
-    SampleIndex index_;
+    std::unique_ptr<Owned> owned_;     ///< null when the samples and their tree are shared
+    const SampleIndex& index_;
+    const Points& P_;                  ///< index_'s samples
+    Points N_;
     Param param_;
     Stats stats_;
     PointOctree octree_;               ///< over P_

@@ -1,6 +1,6 @@
 // PU-RBF robustness: duplicated and piled-up samples, a lone sample, far-apart clusters, fewer
-// samples than a cell's minimum, impossible input, one thread against two, progress, two
-// overlapping sheets with their own spacing. Accuracy on known shapes is in test_pu_rbf.cpp.
+// samples than a cell's minimum, impossible input, one thread against two, a shared k-d tree,
+// progress, two overlapping sheets with their own spacing. Accuracy on known shapes is in test_pu_rbf.cpp.
 #include "geometry.h"
 #include "implicit/pu_rbf.h"
 #include "implicit_accuracy.h"
@@ -137,6 +137,23 @@ TEST(PuRbf, FewerSamplesThanTheMinimum)
     // Down to two samples: still a defined function.
     const PuRbf two(P.topRows(2), N.topRows(2));
     EXPECT_TRUE(AllFiniteOnGrid(two, P.topRows(2)));
+}
+
+// Over a shared k-d tree (the reconstruction's) the function is the one over its own copy of
+// the samples, bit for bit; mismatched normals are refused the same way.
+TEST(PuRbf, SharedSamplesGiveTheSameFunction)
+{
+    Points P, N;
+    TorusPoints(40, 1.0, 0.35, P, N);
+    const SampleIndex samples(P);
+    const PuRbf own(P, N, PuRbf::Param()), shared(samples, N, PuRbf::Param());
+    const Points G = GridAround(P, 32);
+    Eigen::VectorXd a(G.rows()), b(G.rows());
+    own.Eval(G, a);
+    shared.Eval(G, b);
+    EXPECT_EQ(own.Cells(), shared.Cells());
+    EXPECT_EQ(std::memcmp(a.data(), b.data(), sizeof(double) * size_t(a.size())), 0);
+    EXPECT_THROW(PuRbf(samples, N.topRows(10), PuRbf::Param()), std::invalid_argument);
 }
 
 TEST(PuRbf, RejectsImpossibleInput)
