@@ -298,15 +298,27 @@ TEST(Reconstruction, CancelStopsAtEveryStageAndLeavesNothing)
         Reconstruction::Compute(P, N, p, m, &h, &CountCalls);
         const int total = g_calls;
         ASSERT_GT(total, 5);
-        for (int k = 0; k < total; k += std::max(1, total / 10)) {
+        // With 2 threads the fit reports a varying number of times (only the calling thread
+        // reports, as far as it has come): a run may make fewer calls than the counted one, and
+        // then must finish. Any call answered "stop" must cancel the run.
+        int cancelled = 0, tries = 0;
+        for (int k = 0; k < total; k += std::max(1, total / 10), ++tries) {
             g_allowed = k;  // the callback says stop at its (k+1)-th call
             CoreMesh surface, holes;
-            EXPECT_THROW(Reconstruction::Compute(P, N, p, surface, &holes, &StopAfterAllowed), Cancelled) << k;
-            EXPECT_TRUE(surface.vert.empty() && surface.face.empty() && holes.face.empty()) << k;
+            bool stopped = false;
+            try {
+                Reconstruction::Compute(P, N, p, surface, &holes, &StopAfterAllowed);
+            } catch (const Cancelled&) {
+                stopped = true;
+            }
+            EXPECT_EQ(stopped, g_allowed < 0) << k;  // g_allowed < 0: some call answered "stop"
+            if (stopped)
+                EXPECT_TRUE(surface.vert.empty() && surface.face.empty() && holes.face.empty()) << k;
+            cancelled += stopped;
         }
-        g_allowed = total;
-        CoreMesh again, holes;
-        const auto r = Reconstruction::Compute(P, N, p, again, &holes, &StopAfterAllowed);
+        EXPECT_GE(cancelled, tries - 2);
+        CoreMesh again, holes;  // nothing left over from the cancelled runs
+        const auto r = Reconstruction::Compute(P, N, p, again, &holes, &CountCalls);
         EXPECT_EQ(r.loops.size(), 1u);
         EXPECT_EQ(again.face.size(), m.face.size());
     }
