@@ -65,8 +65,6 @@ public:
         SampleCells    ///< the cell holding the sample (the paper's SODS; use with dilation 1)
     };
 
-    static PuRbf::Param LocalFits() { PuRbf::Param f; f.min_samples = 20; f.max_samples = 60; return f; }
-
     struct Param
     {
         int resolution = 0;          ///< cells along the longest bbox side; 0 = from sample spacing
@@ -81,11 +79,7 @@ public:
         /// grid's triangles; zero rows: none. Used when normals are estimated, without viewpoint.
         Points facing;
         Implicit implicit = Implicit::PuRbf;
-        /// The PU-RBF's cells and fits (threads: taken from `threads`): 20-60 samples per cell
-        /// (per scan sheet) instead of the paper's 50-160, whose smoother fits cut across concave
-        /// creases, away from the samples, where the SODS then gates them off into holes
-        /// (BENCHMARKS.md, "Smaller local fits by default").
-        PuRbf::Param rbf = LocalFits();
+        PuRbf::Param rbf = PuRbf::Param::Local();  ///< the PU-RBF's fits (threads: `threads`)
         int hoppe_neighbours = 8;    ///< tangent planes blended by the signed distance
         const ImplicitFunction* given = nullptr;  ///< used with Implicit::Given; not owned
         // The boundary stage's (BoundaryStage::Param: holes filled below min_boundary_edges).
@@ -309,16 +303,10 @@ private:
     {
         if (p.implicit == Implicit::Hoppe)
             return std::make_unique<HoppeDistance>(samples, N, p.hoppe_neighbours, p.threads);
-        PuRbf::Param rp = p.rbf;
+        PuRbf::Param rp =
+            p.scan_sizes.size() > 1 ? p.rbf.PerSheet(SampleSpacing::Overlap(samples, spacing, p.threads)) : p.rbf;
         rp.threads = p.threads;
         rp.spacing = spacing;
-        if (p.scan_sizes.size() > 1) {
-            // Merged scans overlap in sheets a registration error apart: a fit needs its samples
-            // from each sheet, or it follows one sheet's error against the next.
-            const double overlap = SampleSpacing::Overlap(samples, spacing, p.threads);
-            rp.min_samples = std::min(2000, int(std::lround(overlap * rp.min_samples)));
-            rp.max_samples = std::min(5000, int(std::lround(overlap * rp.max_samples)));
-        }
         try {
             return std::make_unique<PuRbf>(samples, N, rp, ProgressRange::Into(cb, 5, 35));
         } catch (const std::invalid_argument& e) {

@@ -21,16 +21,8 @@
 /// the least-squares fit to f = 0 at the samples in the box and f = +-e at the off-surface
 /// points of some of them, which are also its centres u_j, under the moment conditions.
 ///
-/// Off-surface distance: e_i = `off_surface` (default 1) times the local sample spacing at
-/// sample i (spacing.h, or Param::spacing; clamped to [0.5, 2] times the median spacing so
-/// isolated samples and piles of duplicates get a sane value). The spacing, not the cell size,
-/// sets e because it is the scale of detail the samples resolve, and it does not change with
-/// min/max_samples. On the
-/// tests' sphere and torus, clean or noisy, 0.5 to 2 spacings give the same accuracy within
-/// ~25%; one spacing stays above scan noise (a fraction of a spacing) while keeping the points
-/// on the right side of thin parts. The standard check (Carr et al. 2001): an off-surface point
-/// closer to another sample than to its own would cross a thin part or a fold; e is halved up
-/// to twice, then the point is dropped.
+/// Off-surface distance (off_surface.h): `off_surface` local spacings (spacing.h, or
+/// Param::spacing), shortened or dropped where it would cross a thin part.
 ///
 /// Blending: F(x) = sum_c w_c(x) f_c(x) / sum_c w_c(x), with the tensor-product bump
 /// w_c(x) = prod_axis (1 - u_a^2)^2 on the support box (C^1, exactly zero outside the box, so a
@@ -46,11 +38,11 @@
 /// near the samples.
 
 #include "implicit_function.h"
+#include "off_surface.h"
 #include "point_octree.h"
 #include "rbf_local_fit.h"
 #include "../parallel.h"
 #include "../samples.h"
-#include "../spacing.h"
 
 #include <wrap/callback.h>
 
@@ -86,6 +78,27 @@ public:
         /// own scan: overlapping scans multiply the density but lie apart by their registration
         /// error, so off-surface points one merged spacing out land on the next scan's sheet.
         Eigen::VectorXd spacing;
+
+        /// Fits of 20-60 samples per cell instead of the paper's 50-160, whose smoother fits cut
+        /// across concave creases and thin parts, away from the samples (BENCHMARKS.md, "Smaller
+        /// local fits by default"): the reconstruction's default.
+        static Param Local()
+        {
+            Param f;
+            f.min_samples = 20;
+            f.max_samples = 60;
+            return f;
+        }
+
+        /// The same fits per sheet where `sheets` scans overlap (SampleSpacing::Overlap), so a fit
+        /// sees every sheet, not one sheet's registration error against the next. Capped.
+        Param PerSheet(double sheets) const
+        {
+            Param f = *this;
+            f.min_samples = std::min(2000, int(std::lround(sheets * min_samples)));
+            f.max_samples = std::min(5000, int(std::lround(sheets * max_samples)));
+            return f;
+        }
     };
 
     struct Stats
@@ -180,7 +193,11 @@ private:
         octree_ = PointOctree(P_, octree);
         std::vector<PointOctree::Box> boxes = LeafBoxes();
         progress(5, "PU-RBF: off-surface points");
-        OffSurfacePoints();
+        OffSurface::Result off = OffSurface::Compute(index_, N_, param_.spacing, param_.off_surface, param_.threads);
+        eps_ = std::move(off.e);
+        stats_.median_spacing = off.median_spacing;
+        stats_.off_surface_points = off.kept;
+        stats_.off_surface_dropped = off.dropped;
         progress(10, "PU-RBF: fitting local functions");
         Fit(boxes, cb);
         Bound();
@@ -246,46 +263,6 @@ private:
         stats_.cells = int(boxes.size());
         return boxes;
     }
-
-    /// e per sample and side (+ outside, - inside); 0 where the off-surface point is dropped.
-    void OffSurfacePoints()
-    {
-        const Eigen::VectorXd spacing =
-            param_.spacing.size() ? param_.spacing : SampleSpacing::Local(index_, 1, param_.threads);
-        double median = SampleSpacing::Median(spacing);
-        if (!(median > 0))  // most samples duplicated many times: fall back to the area per sample
-            median = (P_.colwise().maxCoeff() - P_.colwise().minCoeff()).norm() / std::sqrt(double(P_.rows()));
-        stats_.median_spacing = median;
-        eps_.resize(P_.rows(), 2);
-        ParallelFor(size_t(P_.rows()), param_.threads, [&](size_t begin, size_t end, int) {
-            SampleIndex::Queue queue;
-            for (size_t s = begin; s < end; ++s) {
-                const Eigen::Index i = Eigen::Index(s);
-                const double e0 = param_.off_surface * std::clamp(spacing[i], 0.5 * median, 2.0 * median);
-                for (int side = 0; side < 2; ++side) {
-                    double e = N_.row(i).squaredNorm() > 0 && e0 > 0 ? e0 : 0;
-                    for (int attempt = 0; e > 0; ++attempt, e *= 0.5) {
-                        if (attempt == 3) {
-                            e = 0;
-                            break;
-                        }
-                        const Eigen::Vector3d o = (P_.row(i) + (side == 0 ? e : -e) * N_.row(i)).transpose();
-                        index_.Nearest(o, 1, queue);
-                        if (queue.getWeight(0) >= e * e * (1 - 1e-6))
-                            break;  // its own sample is (one of) the nearest
-                    }
-                    eps_(i, side) = side == 0 ? e : -e;
-                }
-            }
-        }, 256);
-        for (Eigen::Index i = 0; i < eps_.rows(); ++i)
-            for (int side = 0; side < 2; ++side) {
-                const bool kept = eps_(i, side) != 0;
-                stats_.off_surface_points += kept;
-                stats_.off_surface_dropped += !kept && N_.row(i).squaredNorm() > 0;
-            }
-    }
-
 
     /// The samples of every cell (its support box's, grown where sparse, capped), its centres,
     /// then its local fit.

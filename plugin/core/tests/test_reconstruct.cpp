@@ -312,8 +312,9 @@ TEST(Reconstruction, CancelStopsAtEveryStageAndLeavesNothing)
                 stopped = true;
             }
             EXPECT_EQ(stopped, g_allowed < 0) << k;  // g_allowed < 0: some call answered "stop"
-            if (stopped)
+            if (stopped) {
                 EXPECT_TRUE(surface.vert.empty() && surface.face.empty() && holes.face.empty()) << k;
+            }
             cancelled += stopped;
         }
         EXPECT_GE(cancelled, tries - 2);
