@@ -289,6 +289,9 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 			"neighbours and oriented them %s%s; %zu turned to agree with their neighbours.",
 			p.normal_neighbours, qUtf8Printable(orientation(facing, viewpoint, int(layers.size()))),
 			r.normals_flipped ? " (flipped to point away from the centroid)" : "", r.normals_turned);
+	if (r.covered_scan_edges > 0)
+		log("Left %zu samples on the edges of scans out of the implicit function's fit: other scans cover them "
+			"(a scan's edge is its least reliable part).", r.covered_scan_edges);
 	log("Implicit function: %s%s, built in %.2f s.", qUtf8Printable(kImplicits[int(p.implicit)]),
 		r.rbf_cells > 0 ? qUtf8Printable(QString(" (%1 local RBF fits)").arg(r.rbf_cells)) : "", r.seconds_implicit);
 	log("Lattice %dx%dx%d, cell %g (resolution %d%s, sample spacing %g).",
@@ -339,6 +342,7 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 	res["faces_trimmed"] = double(r.boundary.faces_trimmed);
 	res["boundary_vertices_fitted"] = double(r.boundary.boundary_vertices_fitted);
 	res["seam_points"] = double(r.seam_points);
+	res["covered_scan_edges"] = double(r.covered_scan_edges);
 	res["faces_cut_at_seams"] = double(r.boundary.faces_cut_at_seams);
 	res["duplicates_removed"] = double(r.duplicates_removed);
 	res["outliers_removed"] = double(r.outliers.size());

@@ -109,22 +109,26 @@ def wavy_cap(n, seed=0):
     return u * (1 + wave)[:, None], normals / np.linalg.norm(normals, axis=1, keepdims=True)
 
 
-def overlapping_caps(seed, shift_spacings=0.8, n=5000):
+def overlapping_caps(seed, shift_spacings=0.8, n=5000, edge_curl=0.0):
     """An open cap (the unit sphere above z = -0.5) scanned from four sides, in a new MeshSet:
     one layer per scan, a hemisphere of a jittered Fibonacci sphere of n points seen from its
     side, with exact normals, and a matrix that shifts it by shift_spacings of a scan's spacing
-    in a random direction (the registration error the Align tool leaves). Returns the MeshSet
-    and the spacing within a scan."""
+    in a random direction (the registration error the Align tool leaves). edge_curl: samples
+    seen at grazing angles (the cosine of the view angle under 0.05: a scan's edge) are pulled
+    up to that many spacings off the sphere, as mixed pixels pull a range scan's silhouette.
+    Returns the MeshSet and the spacing within a scan."""
     rng = np.random.default_rng(seed)
     spacing = np.sqrt(4 * np.pi / n)
     ms = pymeshlab.MeshSet()
     for i, side in enumerate([[1, 0, 0.3], [-0.5, 0.87, 0.3], [-0.5, -0.87, 0.3], [0, 0, 1]]):
         u = fibonacci_sphere(n, jitter=0.3, rng=rng)
         u = u[(u[:, 2] > -0.5) & (u @ side > 0)]
+        grazing = np.clip(1 - (u @ side) / np.linalg.norm(side) / 0.05, 0, 1)
+        points = u * (1 + edge_curl * spacing * grazing)[:, None]
         shift = rng.normal(size=3)
         matrix = np.eye(4)
         matrix[:3, 3] = shift_spacings * spacing * shift / np.linalg.norm(shift)
-        ms.add_mesh(pymeshlab.Mesh(vertex_matrix=u, v_normals_matrix=u), f"scan {i}")
+        ms.add_mesh(pymeshlab.Mesh(vertex_matrix=points, v_normals_matrix=u), f"scan {i}")
         ms.set_matrix(transformmatrix=matrix, freeze=False)
     return ms, spacing
 
