@@ -136,6 +136,36 @@ def build_cloud(recipe):
     return points, normals
 
 
+def split_into_scans(recipe, points, normals):
+    """The cloud as recipe["scans"] overlapping range scans: bands along a random axis that
+    overlap by a tenth of the extent, each shifted by a registration error of 0.1% of the
+    diagonal and stored in its own frame, with the rigid matrix that places it (as the Align
+    tool leaves them). A list of (points, normals or None, 4×4 matrix); empty bands left out."""
+    rng = np.random.default_rng(recipe["seed"] + 1)
+    count = recipe.get("scans", 1)
+    finite = np.isfinite(points).all(axis=1)
+    if count <= 1 or not finite.any():
+        return [(points, normals, np.eye(4))]
+    axis = unit(rng.normal(size=3))
+    t = points @ axis
+    lo, hi = t[finite].min(), t[finite].max()
+    width = (hi - lo) / count
+    diagonal = np.linalg.norm(np.ptp(points[finite], axis=0))
+    scans = []
+    for k in range(count):
+        rows = np.flatnonzero(~finite | ((t >= lo + (k - 0.1) * width) & (t <= lo + (k + 1.1) * width)))
+        if len(rows) == 0:
+            continue
+        rotation = np.linalg.qr(rng.normal(size=(3, 3)))[0]
+        rotation *= np.sign(np.linalg.det(rotation))
+        shift = points[finite].mean(axis=0) + 0.001 * diagonal * unit(rng.normal(size=3))
+        matrix = np.eye(4)
+        matrix[:3, :3], matrix[:3, 3] = rotation, shift
+        local = (points[rows] - shift) @ rotation  # inverse(matrix) applied to each row
+        scans.append((local, None if normals is None else normals[rows] @ rotation, matrix))
+    return scans or [(points, normals, np.eye(4))]
+
+
 @st.composite
 def clouds(draw, max_points=MAX_POINTS):
     mesh = draw(st.sampled_from([None] + MESHES)) if MESHES else None
@@ -152,6 +182,7 @@ def clouds(draw, max_points=MAX_POINTS):
         "duplicates": draw(st.sampled_from([0, 0, 0.1, 1.0])),  # fraction of samples repeated
         "nans": draw(st.sampled_from([0] * 8 + [1, 5])),  # mostly clean: NaNs are refused up front
         "normals": draw(st.sampled_from(NORMALS)),
+        "scans": draw(st.sampled_from([1, 1, 1, 2, 3])),  # merged as visible layers when more than 1
         "seed": draw(st.integers(0, 2**32 - 1)),
     }
 

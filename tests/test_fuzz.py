@@ -10,7 +10,9 @@ The default run is bounded (CI); ``IB_FUZZ_PROFILE=fuzz`` (``make fuzz``) runs m
 larger and randomised examples (``IB_FUZZ_EXAMPLES`` sets how many): up to 20,000 points,
 resolutions up to 256, and, where the team's data folder is there (``IB_FUZZ_DATA``, default
 ``../shared/data`` beside the repository), its real meshes with random damage: holes punched,
-noise, outliers, normals dropped, zeroed or duplicated.
+noise, outliers, normals dropped, zeroed or duplicated. Some clouds come as 2 or 3 overlapping
+range scans, each in its own frame with the matrix that places it, merged by the filter
+("merge visible layers").
 """
 import multiprocessing
 import os
@@ -24,7 +26,7 @@ from hypothesis import event, given
 
 from implicit_boundaries.options import Extraction, Implicit, Normals, SodsOccupancy
 from fuzz_checks import DOCUMENTED_REFUSALS, check_answer
-from fuzz_inputs import SETTINGS, build_cloud, clouds, flat_scan, parameters, with_row
+from fuzz_inputs import SETTINGS, build_cloud, clouds, flat_scan, parameters, split_into_scans, with_row
 
 # A run that takes longer than this is a hang (the largest fuzz example takes a few seconds).
 CHILD_TIMEOUT = 600
@@ -48,11 +50,17 @@ def _serve(conn):
             conn.send({"status": "harness error", "message": traceback.format_exc()})
 
 
-def _run(pymeshlab, implicit_boundaries, points, normals, params, mesh_layer=None):
+def _run(pymeshlab, implicit_boundaries, points, normals, params, mesh_layer=None, scans=None):
     """One filter call on a new MeshSet holding the points (layer 0) and, when given, a mesh
-    (vertices, faces) as layer 1 for the implicit_mesh parameter."""
+    (vertices, faces) as layer 1 for the implicit_mesh parameter; or, with `scans`, one layer
+    per scan (points, normals or None, 4×4 matrix), merged by the filter."""
     ms = pymeshlab.MeshSet()
-    if len(points) == 0:  # pymeshlab makes no mesh from an empty matrix, but loads an empty file
+    if scans:
+        for i, (p, n, matrix) in enumerate(scans):
+            ms.add_mesh(pymeshlab.Mesh(vertex_matrix=p) if n is None else
+                        pymeshlab.Mesh(vertex_matrix=p, v_normals_matrix=n), f"scan {i}")
+            ms.set_matrix(transformmatrix=matrix, freeze=False)
+    elif len(points) == 0:  # pymeshlab makes no mesh from an empty matrix, but loads an empty file
         import tempfile
         with tempfile.TemporaryDirectory() as tmp:
             empty = os.path.join(tmp, "empty.ply")
@@ -94,10 +102,10 @@ class Worker:
         self.process.start()
         child_end.close()
 
-    def run(self, points, normals, params, mesh_layer=None):
+    def run(self, points, normals, params, mesh_layer=None, scans=None):
         if self.process is None or not self.process.is_alive():
             self.start()
-        self.conn.send((points, normals, params, mesh_layer))
+        self.conn.send((points, normals, params, mesh_layer, scans))
         if not self.conn.poll(CHILD_TIMEOUT):
             self.stop()
             return {"status": "hang", "message": f"no answer within {CHILD_TIMEOUT} s"}
@@ -130,7 +138,10 @@ def worker():
 
 def run_recipe(worker, recipe, params):
     points, normals = build_cloud(recipe)
-    answer = worker.run(points, normals, params)
+    scans = split_into_scans(recipe, points, normals) if len(points) and recipe.get("scans", 1) > 1 else None
+    if scans:
+        params = {**params, "merge_visible_layers": True}
+    answer = worker.run(points, normals, params, scans=scans)
     check_answer(answer, params)
     return answer
 
@@ -147,7 +158,7 @@ def test_random_clouds_and_parameters(worker, recipe, params):
     event(outcome)
     if os.environ.get("IB_FUZZ_LOG"):  # a line per example checked, for long runs
         with open(os.environ["IB_FUZZ_LOG"], "a") as log:
-            log.write(f"{recipe.get('mesh') or '+'.join(recipe['shapes'])} n={recipe['n']}: {outcome}\n")
+            log.write(f"{recipe.get('mesh') or '+'.join(recipe['shapes'])} n={recipe['n']} scans={recipe.get('scans', 1)}: {outcome}\n")
 
 
 # ---------------------------------------------------------------------------------------------
