@@ -320,13 +320,12 @@ private:
                 for (size_t i = 0; i < covered.size(); ++i)
                     if (!covered[i])
                         fit.push_back(Eigen::Index(i));
-                r.covered_scan_edges = covered.size() - fit.size();
-                if (r.covered_scan_edges > 0 && fit.size() >= size_t(InputCheck::kMinPoints)) {
+                if (fit.size() < covered.size() && fit.size() >= size_t(InputCheck::kMinPoints)) {
+                    r.covered_scan_edges = covered.size() - fit.size();
                     rp.spacing = spacing(fit);
                     return std::make_unique<PuRbf>(Points(samples.P()(fit, Eigen::all)), Points(N(fit, Eigen::all)),
                                                    rp, ProgressRange::Into(cb, 5, 35));
                 }
-                r.covered_scan_edges = 0;
             }
             return std::make_unique<PuRbf>(samples, N, rp, ProgressRange::Into(cb, 5, 35));
         } catch (const std::invalid_argument& e) {

@@ -7,6 +7,7 @@
 
 #include <vcg/space/index/kdtree/kdtree.h>
 
+#include <algorithm>
 #include <vector>
 
 namespace ib {
@@ -55,6 +56,16 @@ inline std::vector<int> ScanOfSamples(const std::vector<Eigen::Index>& sizes, Ei
     for (Eigen::Index i : kept)
         scan.push_back(scanOfRow[size_t(i)]);
     return scan;
+}
+
+/// The samples of each scan: for `scan` (ScanOfSamples, not empty), per scan index the rows that
+/// belong to it, ascending.
+inline std::vector<std::vector<Eigen::Index>> RowsOfScans(const std::vector<int>& scan)
+{
+    std::vector<std::vector<Eigen::Index>> rows(size_t(*std::max_element(scan.begin(), scan.end()) + 1));
+    for (size_t i = 0; i < scan.size(); ++i)
+        rows[size_t(scan[i])].push_back(Eigen::Index(i));
+    return rows;
 }
 
 } // namespace ib

@@ -38,9 +38,7 @@ public:
     {
         const Points& P = samples.P();
         std::vector<char> edge(size_t(P.rows()), 0);
-        std::vector<std::vector<Eigen::Index>> rows(size_t(*std::max_element(scan.begin(), scan.end()) + 1));
-        for (size_t i = 0; i < scan.size(); ++i)
-            rows[size_t(scan[i])].push_back(Eigen::Index(i));
+        const std::vector<std::vector<Eigen::Index>> rows = RowsOfScans(scan);
         for (const std::vector<Eigen::Index>& own : rows) {
             if (own.size() <= size_t(kNeighbours))
                 continue;

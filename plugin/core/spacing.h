@@ -47,9 +47,7 @@ public:
     {
         if (scan.empty())
             return Local(samples, 1, threads);
-        std::vector<std::vector<Eigen::Index>> rows(size_t(*std::max_element(scan.begin(), scan.end()) + 1));
-        for (size_t i = 0; i < scan.size(); ++i)
-            rows[size_t(scan[i])].push_back(Eigen::Index(i));
+        const std::vector<std::vector<Eigen::Index>> rows = RowsOfScans(scan);
         Eigen::VectorXd spacing(samples.Size());
         std::vector<Eigen::Index> unmeasured;
         for (const std::vector<Eigen::Index>& own : rows) {

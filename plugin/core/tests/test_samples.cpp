@@ -48,3 +48,12 @@ TEST(SampleIndex, ScanOfSamplesFollowsTheScansSizes)
     EXPECT_EQ(ScanOfSamples({3, 2}, 5, {0, 2, 3, 4}), (std::vector<int>{0, 0, 1, 1}));
     EXPECT_EQ(ScanOfSamples({1, 0, 2, 2}, 5, {4, 0, 2}), (std::vector<int>{3, 0, 2}));
 }
+
+TEST(SampleIndex, RowsOfScansListsEachScansSamplesInOrder)
+{
+    const std::vector<std::vector<Eigen::Index>> rows = RowsOfScans({1, 0, 1, 2, 0, 2, 2});
+    ASSERT_EQ(rows.size(), 3u);
+    EXPECT_EQ(rows[0], (std::vector<Eigen::Index>{1, 4}));
+    EXPECT_EQ(rows[1], (std::vector<Eigen::Index>{0, 2}));
+    EXPECT_EQ(rows[2], (std::vector<Eigen::Index>{3, 5, 6}));
+}
