@@ -10,9 +10,14 @@ BUILD  ?= build
 JOBS   ?= $(shell nproc)
 SANITIZE_BUILD ?= build-sanitize
 FLOAT_BUILD    ?= build-float
-DOUBLE_PLUGIN  := python/implicit_boundaries/lib/libfilter_implicit_boundaries.so
+DOUBLE_PLUGIN  := $(BUILD)/meshlab-2025.07d/libfilter_implicit_boundaries.so
 FLOAT_PLUGIN   := $(FLOAT_BUILD)/meshlab-2025.07/libfilter_implicit_boundaries.so
 FUZZ_EXAMPLES  ?= 10000
+
+# The Python package finds the double plugin in build/ by itself; another BUILD folder is named to it.
+ifneq ($(BUILD),build)
+export IMPLICIT_BOUNDARIES_PLUGIN ?= $(abspath $(DOUBLE_PLUGIN))
+endif
 
 .PHONY: all deps plugin plugin-float demo wheel install-plugin test test-core test-python test-sanitize fuzz gui gui-double clean
 
@@ -27,6 +32,7 @@ $(BUILD)/CMakeCache.txt: | deps
 
 plugin: deps $(BUILD)/CMakeCache.txt
 	cmake --build $(BUILD) -j $(JOBS)
+	rm -rf python/implicit_boundaries/lib  # where builds before 2026-12 put it: it would shadow this one
 
 # The float plugin, for MeshLab 2025.07 (the build most people run): linked against the
 # libmeshlab-common.so of a float MeshLab built from the same sources (cached, .ci/meshlab-gui).
@@ -42,7 +48,7 @@ demo: plugin
 # A platform wheel with the double plugin inside: `pip install dist/implicit_boundaries-*.whl`
 # where pymeshlab 2025.7.post1 installs (it pulls it in) gives the package and the command line.
 wheel: plugin
-	$(PYTHON) -m pip wheel -q --no-deps -w dist ./python
+	IMPLICIT_BOUNDARIES_PLUGIN=$(abspath $(DOUBLE_PLUGIN)) $(PYTHON) -m pip wheel -q --no-deps -w dist ./python
 	@ls dist/implicit_boundaries-*.whl
 
 test-core: plugin
@@ -94,4 +100,4 @@ install-plugin: plugin plugin-float
 test: test-core test-python gui gui-double test-sanitize
 
 clean:
-	rm -rf $(BUILD) $(SANITIZE_BUILD) $(FLOAT_BUILD) python/implicit_boundaries/lib python/build dist
+	rm -rf $(BUILD) $(SANITIZE_BUILD) $(FLOAT_BUILD) python/build dist

@@ -9,7 +9,6 @@ Each run in its own process, so its peak resident memory is its own.
 """
 import argparse
 import json
-import resource
 import subprocess
 import sys
 import time
@@ -31,10 +30,25 @@ def spacing_estimate(points):
     return float(np.median(np.sqrt(np.pi * r8 ** 2 / 8)))
 
 
+def resident_kib(field):
+    """VmRSS (resident now) or VmHWM (peak since the last reset_peak) of this process, KiB."""
+    for line in Path("/proc/self/status").read_text().splitlines():
+        if line.startswith(field + ":"):
+            return int(line.split()[1])
+    raise RuntimeError(f"no {field} in /proc/self/status")
+
+
+def reset_peak():
+    """Sets the peak resident size to the current one (Linux: clear_refs 5). Without it the peak
+    would include what generating the samples took before the call, and the filter's share
+    (peak - before) would come out too small by a different amount at each size."""
+    Path("/proc/self/clear_refs").write_text("5")
+
+
 def one(n, coarser):
     """One filter call in this process: its loops, surface error and figures. Memory: the
-    process's peak resident size, and its size before the call with the point layer loaded
-    (the filter's own share is the difference, what its memory estimate is for)."""
+    process's resident size before the call with the point layer loaded, and its peak during
+    the call (the filter's own share is the difference, what its memory estimate is for)."""
     points, normals = shapes.wavy_cap(n)
     resolution = 0
     if coarser:
@@ -43,11 +57,12 @@ def one(n, coarser):
     ms = pymeshlab.MeshSet()
     ms.add_mesh(pymeshlab.Mesh(vertex_matrix=points, v_normals_matrix=normals), "samples")
     del points, normals
-    before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    before = resident_kib("VmRSS")
+    reset_peak()
     t = time.perf_counter()
     info = implicit_boundaries.apply(ms, resolution=resolution)
     seconds = time.perf_counter() - t
-    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    peak = resident_kib("VmHWM")
     vertices = ms.current_mesh().vertex_matrix()
     loops = implicit_boundaries.loops_from_result(info)
     u = vertices / np.linalg.norm(vertices, axis=1, keepdims=True)

@@ -32,14 +32,26 @@ def describe_build(build: Optional[Tuple[str, str]]) -> str:
     return f"MeshLab {version}{'d' if scalar == 'double' else ''} ({scalar})"
 
 
+# Where `make plugin` puts the double plugin, relative to the repository root (CMake's build tree).
+BUILT_PLUGIN = Path("build") / "meshlab-2025.07d" / PLUGIN_FILE
+
+
 def plugin_path() -> Path:
-    """Path of the plugin module: $IMPLICIT_BOUNDARIES_PLUGIN, else the one built beside this package."""
-    path = Path(os.environ.get("IMPLICIT_BOUNDARIES_PLUGIN") or Path(__file__).parent / "lib" / PLUGIN_FILE)
-    if not path.is_file():
-        raise FileNotFoundError(
-            f"the plugin {path} is not built: run 'make' at the repository root "
-            "(or set IMPLICIT_BOUNDARIES_PLUGIN to a built libfilter_implicit_boundaries.so)")
-    return path
+    """Path of the plugin module: $IMPLICIT_BOUNDARIES_PLUGIN; else the one the wheel carries in
+    this package's lib/; else, in a source checkout, the one `make plugin` built (build/)."""
+    if os.environ.get("IMPLICIT_BOUNDARIES_PLUGIN"):
+        path = Path(os.environ["IMPLICIT_BOUNDARIES_PLUGIN"])
+        if not path.is_file():
+            raise FileNotFoundError(f"IMPLICIT_BOUNDARIES_PLUGIN is {path}, which is not a file: "
+                                    "set it to a built libfilter_implicit_boundaries.so")
+        return path
+    package = Path(__file__).resolve().parent
+    for path in (package / "lib" / PLUGIN_FILE, package.parent.parent / BUILT_PLUGIN):
+        if path.is_file():
+            return path
+    raise FileNotFoundError(
+        f"the plugin is not built: run 'make plugin' at the repository root (it writes {BUILT_PLUGIN}), "
+        "install the wheel, or set IMPLICIT_BOUNDARIES_PLUGIN to a built libfilter_implicit_boundaries.so")
 
 
 def apply(ms: pymeshlab.MeshSet, **kwargs) -> dict:
@@ -78,7 +90,7 @@ def load() -> Path:
         raise PluginMismatchError(
             f"the plugin {path} is built for {describe_build(build)}; pymeshlab 2025.7.post1 embeds "
             f"{describe_build(PYMESHLAB_MESHLAB)}: use the double plugin "
-            "('make plugin' builds it into python/implicit_boundaries/lib; the wheel carries it). "
+            "('make plugin' builds it into build/meshlab-2025.07d; the wheel carries it). "
             "The float one is for the MeshLab 2025.07 GUI")
     if FILTER_NAME not in pymeshlab.filter_list():
         pymeshlab.load_plugin(str(path))
