@@ -1,4 +1,6 @@
 """The filter through pymeshlab: loading, binding, results on real scans, and bad input."""
+from pathlib import Path
+
 import numpy as np
 import pymeshlab
 import pytest
@@ -7,6 +9,7 @@ from scipy.spatial import cKDTree
 import implicit_boundaries
 from conftest import SAMPLES, point_cloud
 from shapes import fibonacci_sphere
+from implicit_boundaries._plugin import BUILT_PLUGIN
 from implicit_boundaries.cloud import read_mesh
 from implicit_boundaries.metrics import boundary_vertex_sets, match_loops
 from implicit_boundaries.options import Extraction, Implicit, SodsOccupancy
@@ -21,6 +24,21 @@ def new_set(points, normals=None):
     else:
         ms.add_mesh(pymeshlab.Mesh(vertex_matrix=points, v_normals_matrix=normals), "points")
     return ms
+
+
+def test_a_checkout_finds_the_plugin_in_the_build_tree_not_in_the_sources(monkeypatch):
+    root = Path(__file__).resolve().parent.parent
+    if not (root / BUILT_PLUGIN).is_file():
+        pytest.skip("built into another folder than build/ (make BUILD=...)")
+    monkeypatch.delenv("IMPLICIT_BOUNDARIES_PLUGIN", raising=False)
+    assert implicit_boundaries.plugin_path() == root / BUILT_PLUGIN
+    assert not (root / "python" / "implicit_boundaries" / "lib").exists()
+
+
+def test_a_plugin_path_that_is_not_a_file_says_what_to_set(monkeypatch, tmp_path):
+    monkeypatch.setenv("IMPLICIT_BOUNDARIES_PLUGIN", str(tmp_path / "missing.so"))
+    with pytest.raises(FileNotFoundError, match="IMPLICIT_BOUNDARIES_PLUGIN is .*missing.so, which is not a file"):
+        implicit_boundaries.plugin_path()
 
 
 def test_plugin_loads_and_binds_the_method(plugin):
