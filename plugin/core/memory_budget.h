@@ -19,20 +19,21 @@ struct MemoryBudget
 {
     /// The peak growth of a run is modelled as kBytesFixed + kBytesPerSample × samples +
     /// kBytesPerSodsCell × SODS cells, fitted to peaks measured through pymeshlab (the process's
-    /// peak resident size over its size with the point layer loaded; `bench/large_scan.py`,
-    /// random samples of a smooth open surface at the automatic resolution): 100k, 1M, 5M, 10M
-    /// and 20M samples with 0.59M to 3.9M cells, peaks 0.18 to 4.3 GB. The estimate lies 4% to
-    /// 26% above each measured peak (BENCHMARKS.md; the peaks do not grow linearly with the
-    /// samples, and the estimate must never be below one).
+    /// resident size before the call, with the point layer loaded, against its peak during the
+    /// call; `bench/large_scan.py`, random samples of a smooth open surface at the automatic
+    /// resolution): 100k, 1M, 5M, 10M and 20M samples with 0.59M to 3.9M cells, peaks 0.20 to
+    /// 7.6 GB. The estimate lies 1% to 15% above each measured peak (BENCHMARKS.md): the
+    /// smallest per-sample term that is never below one, with the per-cell term that then keeps
+    /// the largest excess smallest.
     ///
     /// Per SODS cell: corner values and welded edge vertices (hash maps), the extracted
     /// vertices and faces with adjacency, and the host's copy of the result.
-    static constexpr double kBytesPerSodsCell = 300;
+    static constexpr double kBytesPerSodsCell = 270;
     /// Per input sample, held while the surface is extracted: the input and its distinct,
     /// outlier-free copy, normals, the shared k-d tree (the PU-RBF's too), local spacings, the
     /// points projected onto the zero set and the PU-RBF's octree and local fits (one per 20 to
-    /// 60 samples).
-    static constexpr double kBytesPerSample = 200;
+    /// 60 samples, ~2.6 kB each: about 1 GB of the 2.7 GB peak at 5M samples).
+    static constexpr double kBytesPerSample = 380;
     /// Thread stacks, the allocator's arenas, small tables.
     static constexpr double kBytesFixed = 30e6;
 

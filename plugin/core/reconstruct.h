@@ -314,14 +314,9 @@ private:
         rp.spacing = spacing;
         try {
             if (p.scan_sizes.size() > 1) {
-                const std::vector<char> covered =
-                    ScanEdges::Covered(samples, ScanEdges::Edges(samples, N, scan, p.threads), scan, spacing, p.threads);
-                std::vector<Eigen::Index> fit;
-                for (size_t i = 0; i < covered.size(); ++i)
-                    if (!covered[i])
-                        fit.push_back(Eigen::Index(i));
-                if (fit.size() < covered.size() && fit.size() >= size_t(InputCheck::kMinPoints)) {
-                    r.covered_scan_edges = covered.size() - fit.size();
+                const std::vector<Eigen::Index> fit = ScanEdges::Uncovered(samples, N, scan, spacing, p.threads);
+                if (fit.size() < size_t(samples.Size()) && fit.size() >= size_t(InputCheck::kMinPoints)) {
+                    r.covered_scan_edges = size_t(samples.Size()) - fit.size();
                     rp.spacing = spacing(fit);
                     return std::make_unique<PuRbf>(Points(samples.P()(fit, Eigen::all)), Points(N(fit, Eigen::all)),
                                                    rp, ProgressRange::Into(cb, 5, 35));

@@ -96,6 +96,20 @@ public:
         }, 256);
         return covered;
     }
+
+    /// The rows of the samples a merged reconstruction fits its implicit function to, ascending:
+    /// all but the edge samples (Edges, with unit normals N) that another scan covers (Covered).
+    static std::vector<Eigen::Index> Uncovered(const SampleIndex& samples, const Points& N,
+                                               const std::vector<int>& scan, const Eigen::VectorXd& spacing,
+                                               int threads)
+    {
+        const std::vector<char> covered = Covered(samples, Edges(samples, N, scan, threads), scan, spacing, threads);
+        std::vector<Eigen::Index> rows;
+        for (size_t i = 0; i < covered.size(); ++i)
+            if (!covered[i])
+                rows.push_back(Eigen::Index(i));
+        return rows;
+    }
 };
 
 } // namespace ib

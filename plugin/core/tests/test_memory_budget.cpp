@@ -24,7 +24,7 @@ std::string Refusal(double samples, double cells, bool dense, double corners, do
 TEST(MemoryBudget, PeakIsTheLinearModelAndGrowsWithEachTerm)
 {
     EXPECT_EQ(MemoryBudget::PeakBytes(0, 0, 0), MemoryBudget::kBytesFixed);
-    EXPECT_DOUBLE_EQ(MemoryBudget::PeakBytes(1000, 2000, 3000), 30e6 + 200e3 + 600e3 + 24e3);
+    EXPECT_DOUBLE_EQ(MemoryBudget::PeakBytes(1000, 2000, 3000), 30e6 + 380e3 + 540e3 + 24e3);
     const double base = MemoryBudget::PeakBytes(1e6, 1e6, 1e6);
     EXPECT_GT(MemoryBudget::PeakBytes(2e6, 1e6, 1e6), base);
     EXPECT_GT(MemoryBudget::PeakBytes(1e6, 2e6, 1e6), base);
@@ -43,9 +43,9 @@ TEST(MemoryBudget, CheckReturnsTheEstimateUnderTheLimit)
 
 TEST(MemoryBudget, RefusalSaysHowMuchAndWhatToChange)
 {
-    // 2M samples and 10M cells: 30 MB + 400 MB + 3 GB = 3.43 GB, over a 2 GB limit.
+    // 2M samples and 10M cells: 30 MB + 760 MB + 2.7 GB = 3.49 GB, over a 2 GB limit.
     const std::string sods = Refusal(2e6, 1e7, false, 0, 2e9, 900);
-    EXPECT_EQ(sods, "Resolution 900 would need about 3.43 GB of memory (2000000 samples, 10000000 occupied "
+    EXPECT_EQ(sods, "Resolution 900 would need about 3.49 GB of memory (2000000 samples, 10000000 occupied "
                     "cells), over the limit of 2.00 GB: lower the resolution (0 = automatic) or raise the "
                     "memory limit.");
     const std::string dense = Refusal(1e6, 1e5, true, 1e9, 2e9, 1000);
@@ -53,6 +53,6 @@ TEST(MemoryBudget, RefusalSaysHowMuchAndWhatToChange)
     EXPECT_NE(dense.find("use the SODS-driven extraction"), std::string::npos) << dense;
     // The samples alone over the limit: no resolution helps.
     const std::string samples = Refusal(2e7, 1e3, false, 0, 1e9, 100);
-    EXPECT_NE(samples.find("the samples alone need about 4.03 GB; thin them out"), std::string::npos) << samples;
+    EXPECT_NE(samples.find("the samples alone need about 7.63 GB; thin them out"), std::string::npos) << samples;
     EXPECT_EQ(samples.find("lower the resolution"), std::string::npos) << samples;
 }

@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 using namespace ib;
 using test::FlatScan;
 
@@ -83,4 +85,30 @@ TEST(ScanEdges, AnEdgeIsCoveredWhereAnotherScanLiesOverIt)
     EXPECT_EQ(top.covered, top.samples);
     EXPECT_GT(bottom.samples, 15u);
     EXPECT_EQ(bottom.covered, 0u);
+}
+
+TEST(ScanEdges, UncoveredListsEverySampleButTheCoveredEdges)
+{
+    // Scan 1, as dense, over scan 0's right half, a quarter spacing above: scan 0's right edge
+    // and scan 1's left edge lie over the other scan's inside.
+    const double s = 0.02;
+    Points a, Na;
+    FlatScan(s, a, Na);
+    const Points b = a.rowwise() + Eigen::RowVector3d(0.5, 0, 0.25 * s);
+    Points P(2 * a.rows(), 3), N(2 * a.rows(), 3);
+    P << a, b;
+    N << Na, Na;
+    std::vector<int> scan(size_t(P.rows()), 0);
+    std::fill(scan.begin() + a.rows(), scan.end(), 1);
+    const SampleIndex samples(P);
+    const Eigen::VectorXd spacing = Eigen::VectorXd::Constant(P.rows(), s);
+    const std::vector<char> covered =
+        ScanEdges::Covered(samples, ScanEdges::Edges(samples, N, scan, 1), scan, spacing, 1);
+    const std::vector<Eigen::Index> rows = ScanEdges::Uncovered(samples, N, scan, spacing, 1);
+    const size_t coveredCount = size_t(std::count(covered.begin(), covered.end(), 1));
+    EXPECT_GT(coveredCount, 50u);  // the two edges that lie over the other scan, ~50 samples each
+    ASSERT_EQ(rows.size(), size_t(P.rows()) - coveredCount);
+    EXPECT_TRUE(std::is_sorted(rows.begin(), rows.end()));
+    for (Eigen::Index i : rows)
+        EXPECT_FALSE(covered[size_t(i)]) << P.row(i);
 }
