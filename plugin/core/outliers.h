@@ -66,6 +66,23 @@ public:
         return kept;
     }
 
+    /// The rows `rows` of P (ascending) without their outliers (Kept over P(rows)), in order;
+    /// the outliers' rows are appended to `outliers`.
+    static std::vector<Eigen::Index> KeptRows(const Points& P, std::vector<Eigen::Index> rows,
+                                              std::vector<Eigen::Index>& outliers, int threads = 0)
+    {
+        const std::vector<Eigen::Index> inliers = Kept(SampleIndex(P(rows, Eigen::all)), threads);
+        outliers.reserve(outliers.size() + rows.size() - inliers.size());
+        for (size_t i = 0, j = 0; i < rows.size(); ++i) {
+            if (j < inliers.size() && inliers[j] == Eigen::Index(i))
+                rows[j++] = rows[i];
+            else
+                outliers.push_back(rows[i]);
+        }
+        rows.resize(inliers.size());
+        return rows;
+    }
+
     /// A sparse group is a set of samples, each with a neighbourhood over kSparse times wider
     /// than the median one, linked by being among each other's nearest, with fewer than
     /// kMinGroup members. Strays scattered through the empty space of a bounding box form such

@@ -2,11 +2,12 @@
 /// \file progress.h
 /// Progress and cancellation through VCG's callback (a plain function pointer): a stage's
 /// 0..100 mapped into a range of the caller's bar, and the host's "stop" turned into an
-/// exception thrown from the next progress report.
+/// exception thrown from the next progress report. Also the stages' wall-clock timing.
 
 #include <wrap/callback.h>
 
 #include <algorithm>
+#include <chrono>
 #include <stdexcept>
 
 namespace ib {
@@ -64,6 +65,24 @@ private:
     }
     static inline thread_local vcg::CallBackPos* target_ = nullptr;
     static inline thread_local int lo_ = 0, hi_ = 100;
+};
+
+/// Wall-clock seconds of consecutive stages: each Lap() is the time since the previous one
+/// (or since construction), and starts the next.
+class Stopwatch
+{
+public:
+    double Lap()
+    {
+        const Clock::time_point now = Clock::now();
+        const double seconds = std::chrono::duration<double>(now - start_).count();
+        start_ = now;
+        return seconds;
+    }
+
+private:
+    using Clock = std::chrono::steady_clock;
+    Clock::time_point start_ = Clock::now();
 };
 
 } // namespace ib

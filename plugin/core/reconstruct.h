@@ -21,7 +21,6 @@
 #include "spacing.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <memory>
 #include <stdexcept>
@@ -157,8 +156,6 @@ private:
     static Result Run(const Points& input, const Points& inputNormals, const Param& p, CoreMesh& surface,
                       CoreMesh* holes, vcg::CallBackPos* cb)
     {
-        using Clock = std::chrono::steady_clock;
-        auto seconds = [](Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); };
         InputCheck::Samples(input, inputNormals, p.facing, p.scan_sizes);
         CheckParam(p);
         Result r;
@@ -169,19 +166,8 @@ private:
         if (Eigen::Index(kept.size()) < InputCheck::kMinPoints)
             throw InputError("Only " + std::to_string(kept.size()) + " distinct vertex positions; at least " +
                              std::to_string(InputCheck::kMinPoints) + " are needed to fit tangent planes.");
-        auto t = Clock::now();
-        {
-            const Points distinct = input(kept, Eigen::all);
-            const std::vector<Eigen::Index> inliers = Outliers::Kept(SampleIndex(distinct), p.threads);
-            r.outliers.reserve(kept.size() - inliers.size());
-            for (size_t i = 0, j = 0; i < kept.size(); ++i) {
-                if (j < inliers.size() && inliers[j] == Eigen::Index(i))
-                    kept[j++] = kept[i];
-                else
-                    r.outliers.push_back(kept[i]);
-            }
-            kept.resize(inliers.size());
-        }
+        Stopwatch watch;
+        kept = Outliers::KeptRows(input, std::move(kept), r.outliers, p.threads);
         const Points P = input(kept, Eigen::all);
         const Points N = inputNormals.rows() ? Points(inputNormals(kept, Eigen::all)) : Points();
         if (P.rows() < InputCheck::kMinPoints)
@@ -192,9 +178,8 @@ private:
         const SampleIndex samples(P);  // the k-d tree every stage shares, from normals to the trim
         const Points facing = p.facing.rows() ? Points(p.facing(kept, Eigen::all)) : Points();
         const Points normals = OrientedNormals(samples, N, facing, p, r, cb);
-        r.seconds_normals = seconds(t);
+        r.seconds_normals = watch.Lap();
 
-        t = Clock::now();
         if (cb) cb(5, "Building the implicit function");
         const std::vector<int> scan = ScanOfSamples(p.scan_sizes, input.rows(), kept);
         const Eigen::VectorXd spacing = SampleSpacing::PerScan(samples, scan, p.threads);
@@ -229,9 +214,8 @@ private:
         const ImplicitFunction& f = fitted ? *fitted : *p.given;
         if (const auto* rbf = dynamic_cast<const PuRbf*>(fitted.get()))
             r.rbf_cells = rbf->Cells();
-        r.seconds_implicit = seconds(t);
+        r.seconds_implicit = watch.Lap();
 
-        t = Clock::now();
         if (cb) cb(36, "Building the spatial occupancy data structure");
         // At a thin part's rim the surface turns between the two sides' flat disks: there they
         // reach half way to the other side. On cells finer than the automatic resolution's for
@@ -253,10 +237,9 @@ private:
         for (int i = 0; i < p.sods_dilation; ++i)
             sods = sods.Dilated();
         r.sods_cells = sods.Count();
-        r.seconds_sods = seconds(t);
+        r.seconds_sods = watch.Lap();
         r.memory_estimate = CheckMemory(p, lattice, double(input.rows()), double(r.sods_cells), r);
 
-        t = Clock::now();
         // Extracted straight into `surface`: the hole faces are split off at the end, so a large
         // run never holds two copies of its mesh.
         surface.Clear();
@@ -268,10 +251,9 @@ private:
         r.crossed_cell_corners = mc.crossed_corners;
         r.hole_cells = mc.hole_cells;
         r.hole_search_capped = mc.hole_search_capped;
-        r.seconds_extraction = seconds(t);
+        r.seconds_extraction = watch.Lap();
         MemoryBudget::ReleaseFreed();  // the corner and edge hash maps, before the boundary stage grows
 
-        t = Clock::now();
         if (cb) cb(97, "Tracing boundary loops, filling small holes");
         const Points seam = OrientationSeam::Find(samples, normals, spacing, foldWidth, p.threads, scan);
         r.seam_points = size_t(seam.rows());
@@ -293,7 +275,7 @@ private:
                                    " after its repair");
         r.loops = BoundaryLoops::Compute(surface);
         MemoryBudget::ReleaseFreed();  // before the host copies the surface
-        r.seconds_boundaries = seconds(t);
+        r.seconds_boundaries = watch.Lap();
         return r;
     }
 
@@ -349,7 +331,6 @@ private:
         return normals;
     }
 
-private:
     /// The boundary stage's parameters from the pipeline's, on the lattice and spacing of r.
     static BoundaryStage::Param BoundaryParam(const Param& p, const Result& r)
     {

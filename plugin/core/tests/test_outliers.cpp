@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 
 using namespace ib;
@@ -79,4 +80,25 @@ TEST(Outliers, KeepsEveryOneOfFewSamples)
 {
     const Points P = Stack({{0, 0, 0}, {1, 0, 0}, {100, 0, 0}});
     EXPECT_EQ(Outliers::Kept(SampleIndex(P)).size(), 3u);
+}
+
+TEST(Outliers, KeptRowsMapsASubsetsOutliersBackToItsRows)
+{
+    // The surface and two strays, of which only every second surface sample and the strays are
+    // given as rows: the strays' own rows come out as outliers, after the ones already listed.
+    std::vector<Eigen::RowVector3d> ps = UnevenPlane();
+    const Eigen::Index surface = Eigen::Index(ps.size());
+    ps.emplace_back(0, 0, 100);
+    ps.emplace_back(-1, 1, 0.7);
+    const Points P = Stack(ps);
+    std::vector<Eigen::Index> rows;
+    for (Eigen::Index i = 0; i < surface; i += 2)
+        rows.push_back(i);
+    rows.push_back(surface);
+    rows.push_back(surface + 1);
+    std::vector<Eigen::Index> outliers{7};
+    const std::vector<Eigen::Index> kept = Outliers::KeptRows(P, rows, outliers, 1);
+    EXPECT_EQ(outliers, (std::vector<Eigen::Index>{7, surface, surface + 1}));
+    ASSERT_EQ(kept.size(), rows.size() - 2);
+    EXPECT_TRUE(std::equal(kept.begin(), kept.end(), rows.begin()));
 }

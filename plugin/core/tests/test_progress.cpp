@@ -1,9 +1,10 @@
-// Progress ranges and cancellation through VCG's plain function-pointer callback.
+// Progress ranges and cancellation through VCG's plain function-pointer callback; stage timing.
 #include "progress.h"
 
 #include <gtest/gtest.h>
 
 #include <string>
+#include <thread>
 #include <vector>
 
 using namespace ib;
@@ -58,4 +59,15 @@ TEST(Progress, CancellationTurnsStopIntoAnException)
     }
     EXPECT_EQ(g_positions.back(), 50);
     g_answer = true;
+}
+
+TEST(Progress, StopwatchLapsAreTheStagesOwnTimes)
+{
+    Stopwatch watch;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    const double first = watch.Lap();  // includes the 20 ms
+    const double second = watch.Lap(); // only the time since the first lap, no sleep in it
+    EXPECT_GE(first, 0.02);
+    EXPECT_GE(second, 0.0);
+    EXPECT_LT(second, first);
 }
