@@ -32,7 +32,7 @@ struct MemoryBudget
     /// Per input sample, held while the surface is extracted: the input and its distinct,
     /// outlier-free copy, normals, the shared k-d tree (the PU-RBF's too), local spacings, the
     /// points projected onto the zero set and the PU-RBF's octree and local fits (one per 20 to
-    /// 60 samples, ~2.6 kB each: about 1 GB of the 2.7 GB peak at 5M samples).
+    /// 60 samples; the PU-RBF stage grows the process by about 1 GB of the 2.7 GB peak at 5M).
     static constexpr double kBytesPerSample = 380;
     /// Thread stacks, the allocator's arenas, small tables.
     static constexpr double kBytesFixed = 30e6;
