@@ -7,7 +7,9 @@ edges the true boundaries). Conditions: "clean" (the vertices with normals from 
 normals), "no normals" (clean points, the filter estimates the normals), "outliers 0.1%" (the
 clean input plus 0.1% of its sample count drawn uniformly in the bounding box with random
 normals, and one sample at ten times the diagonal; its time is over the clean run's, and the
-farthest face from the true surface is in local spacings of the nearest sample). Per mesh and
+farthest face from the true surface is in local spacings of the nearest sample), "mesh" (the
+clean vertices and normals with the mesh's own faces, as MeshLab loads the file: the filter keeps
+the triangulation's holes open, keep_mesh_holes). Per mesh and
 condition: loops found / true loops, boundary distance, spurious and missing area (the
 yardsticks of docs/yardsticks.md: surface farther than 1% of the diagonal from the other
 surface) and our time over screened Poisson's at matched depth, in the same run. A summary per
@@ -48,7 +50,7 @@ CASES = {
     "corpus/alligator.obj": "flat",
     "corpus/halftunnel.off": "CAD, creases, quad mesh",
 }
-CONDITIONS = ["clean", "noise 0.2%", "no normals", "outliers 0.1%"]
+CONDITIONS = ["clean", "noise 0.2%", "no normals", "outliers 0.1%", "mesh"]
 TOLERANCE = 0.01  # spurious and missing area: farther than 1% of the diagonal
 
 
@@ -64,27 +66,33 @@ def load_case(path):
     return m.vertex_matrix().copy(), m.vertex_normal_matrix().copy(), m.face_matrix().copy()
 
 
-def condition_input(condition, points, normals, rng):
+def condition_input(condition, points, normals, faces, rng):
+    """The input of a condition: points, normals (None: none) and faces (None: a point cloud)."""
     diagonal = np.linalg.norm(np.ptp(points, axis=0))
+    if condition == "mesh":
+        return points, normals, faces if len(faces) else None
     if condition == "noise 0.2%":
-        return points + rng.normal(0, 0.002 * diagonal, points.shape), normals
+        return points + rng.normal(0, 0.002 * diagonal, points.shape), normals, None
     if condition == "outliers 0.1%":
         count = max(1, len(points) // 1000)
         strays = rng.uniform(points.min(axis=0), points.max(axis=0), (count, 3))
         stray_normals = rng.normal(size=(count, 3))
         stray_normals /= np.linalg.norm(stray_normals, axis=1, keepdims=True)
         far = points.max(axis=0) + [10 * diagonal, 0, 0]
-        return np.vstack([points, strays, far]), np.vstack([normals, stray_normals, [[1, 0, 0]]])
+        return np.vstack([points, strays, far]), np.vstack([normals, stray_normals, [[1, 0, 0]]]), None
     if condition == "no normals":
-        return points, None
-    return points, normals
+        return points, None, None
+    return points, normals, None
 
 
-def ours(points, normals, params):
+def ours(points, normals, faces, params):
     ms = pymeshlab.MeshSet()
-    mesh = (pymeshlab.Mesh(vertex_matrix=points) if normals is None
-            else pymeshlab.Mesh(vertex_matrix=points, v_normals_matrix=normals))
-    ms.add_mesh(mesh, "points")
+    arrays = dict(vertex_matrix=points)
+    if normals is not None:
+        arrays["v_normals_matrix"] = normals
+    if faces is not None:
+        arrays["face_matrix"] = faces
+    ms.add_mesh(pymeshlab.Mesh(**arrays), "points")
     t = time.perf_counter()
     out = implicit_boundaries.apply(ms, **params)
     seconds = time.perf_counter() - t
@@ -114,8 +122,8 @@ def measure(name, condition, points, normals, faces, rng, params, clean_seconds=
     diagonal = np.linalg.norm(np.ptp(points, axis=0))
     step = 0.0005 * diagonal
     true_loops = len(boundary_vertex_sets(faces, len(points))) if len(faces) else 0
-    cloud, cloud_normals = condition_input(condition, points, normals, rng)
-    out, vertices, out_faces, seconds = ours(cloud, cloud_normals, params)
+    cloud, cloud_normals, cloud_faces = condition_input(condition, points, normals, faces, rng)
+    out, vertices, out_faces, seconds = ours(cloud, cloud_normals, cloud_faces, params)
     row = {"mesh": name, "condition": condition, "samples": len(points), "true": true_loops,
            "loops": int(out["boundary_loops"]), "edges": np.asarray(out["boundary_loop_edges"]).astype(int).tolist(),
            "resolution": int(out["resolution"]), "outliers": int(out.get("outliers_removed", 0))}

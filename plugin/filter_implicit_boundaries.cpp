@@ -12,6 +12,7 @@
 namespace {
 
 using ib_plugin::FacingSources;
+using ib_plugin::faceMatrix;
 using ib_plugin::facingMatrix;
 using ib_plugin::implicitMesh;
 using ib_plugin::inputLayers;
@@ -206,6 +207,8 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 		for (const MeshModel* m : layers)
 			p.scan_sizes.push_back(m->cm.vn);
 	const ib::Points layerNormals = stackedMatrix(layers, true);
+	if (layers.size() == 1 && par.getBool("keep_mesh_holes"))
+		p.faces = faceMatrix(layers[0]->cm);
 	FacingSources facing;
 	if (p.normals == ib::Reconstruction::NormalSource::Estimate || !layerNormals.array().isFinite().all() ||
 		(layerNormals.array() == 0).all())
@@ -316,6 +319,9 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 			"vertices where separate fans met.", r.faces_not_manifold, r.vertices_split);
 	if (holeLayer && holes.fn == 0)
 		log("No hole triangles to show (every hole was filled, or none closes): no holes layer added.");
+	if (p.faces.rows() > 0)
+		log("The layer's %lld faces keep its holes open: cut %zu faces of the surface where it passed over none of "
+			"them.", (long long)p.faces.rows(), r.boundary.faces_cut_at_mesh_holes);
 	if (r.seam_points > 0)
 		log("The normals flip between neighbouring samples at %zu places (a one-sided surface, or a region "
 			"oriented inside out): cut the surface there (%zu faces) into a boundary. If that region should "
@@ -344,6 +350,7 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 	res["seam_points"] = double(r.seam_points);
 	res["covered_scan_edges"] = double(r.covered_scan_edges);
 	res["faces_cut_at_seams"] = double(r.boundary.faces_cut_at_seams);
+	res["faces_cut_at_mesh_holes"] = double(r.boundary.faces_cut_at_mesh_holes);
 	res["duplicates_removed"] = double(r.duplicates_removed);
 	res["outliers_removed"] = double(r.outliers.size());
 	res["faces_unsupported"] = double(r.boundary.faces_unsupported);

@@ -171,6 +171,14 @@ RichParameterList FilterImplicitBoundariesPlugin::reconstructionParameters(const
 		"the trim leaves.",
 		true));
 	par.addParam(RichBool(
+		"keep_mesh_holes", true, "Keep the mesh's holes",
+		"When the layer has faces (a triangulated scan, a mesh to remesh), the surface is cut where "
+		"it passes over none of them, so every hole of the triangulation stays open, however "
+		"small its gap between vertices (as points alone the tangent disks would bridge it); "
+		"openings whose loop has fewer than 'Min boundary edges' edges are still filled. Off: "
+		"the faces are ignored, as for a point cloud. Merged layers always ignore faces.",
+		true));
+	par.addParam(RichBool(
 		"merge_visible_layers", false, "Merge visible layers",
 		"Reconstruct one surface from the vertices of every visible layer, each through its own "
 		"transformation matrix: several range scans aligned with the Align tool. Overlapping scans "

@@ -89,6 +89,25 @@ ib::Points stackedMatrix(const std::vector<const MeshModel*>& layers, bool norma
 	return out;
 }
 
+/// Read around deleted elements rather than compacting: the user's layer stays untouched.
+ib::Faces faceMatrix(const CMeshO& m)
+{
+	std::vector<int> row(m.vert.size(), -1);
+	int n = 0;
+	for (size_t i = 0; i < m.vert.size(); ++i)
+		if (!m.vert[i].IsD())
+			row[i] = n++;
+	ib::Faces F(m.fn, 3);
+	int k = 0;
+	for (const auto& f : m.face)
+		if (!f.IsD()) {
+			for (int c = 0; c < 3; ++c)
+				F(k, c) = row[vcg::tri::Index(m, f.cV(c))];
+			++k;
+		}
+	return F;
+}
+
 /// Per vertex of `layers` (rows as stackedMatrix), the direction its estimated normal must
 /// face, in the common frame: towards the layer's camera when it has one (a scan imported with
 /// its scanner's position), else along the layer's triangles around it (a range grid's
@@ -152,24 +171,8 @@ std::unique_ptr<ib::MeshDistance> implicitMesh(MeshDocument& md, unsigned int id
 		throw MLException(QString("The implicit mesh layer '%1' has no faces: choose a closed triangle mesh, e.g. the "
 								  "output of Screened Poisson on the points.")
 							  .arg(model->label()));
-	// Read around deleted elements rather than compacting: the user's layer stays untouched.
-	const CMeshO& cm = model->cm;
-	std::vector<int> row(cm.vert.size(), -1);
-	ib::Points V(cm.vn, 3);
-	int n = 0;
-	for (size_t i = 0; i < cm.vert.size(); ++i)
-		if (!cm.vert[i].IsD()) {
-			V.row(n) << cm.vert[i].cP()[0], cm.vert[i].cP()[1], cm.vert[i].cP()[2];
-			row[i] = n++;
-		}
-	Eigen::Matrix<int, Eigen::Dynamic, 3, Eigen::RowMajor> F(cm.fn, 3);
-	int m = 0;
-	for (const auto& f : cm.face)
-		if (!f.IsD()) {
-			for (int k = 0; k < 3; ++k)
-				F(m, k) = row[vcg::tri::Index(cm, f.cV(k))];
-			++m;
-		}
+	const ib::Points V = vertexMatrix(model->cm, false);
+	const ib::Faces F = faceMatrix(model->cm);
 	try {
 		return std::make_unique<ib::MeshDistance>(V, F);
 	}

@@ -26,6 +26,8 @@ struct FacingSources
 std::vector<const MeshModel*> inputLayers(const MeshDocument& md, bool merge);
 /// The vertices (normals = false) or normals of `layers`, one after the other.
 ib::Points stackedMatrix(const std::vector<const MeshModel*>& layers, bool normals);
+/// The faces of layer `m` (rows as the vertices of stackedMatrix: deleted ones skipped).
+ib::Faces faceMatrix(const CMeshO& m);
 /// Per vertex of `layers`, the direction its estimated normal must face (zero: unknown).
 ib::Points facingMatrix(const std::vector<const MeshModel*>& layers, const std::optional<Eigen::Vector3d>& viewpoint,
 						FacingSources& used);

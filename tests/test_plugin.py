@@ -66,15 +66,17 @@ def test_filter_makes_a_new_current_layer_with_loops_selected(plugin):
         assert result[f"seconds_{stage}"] >= 0
 
 
-def bunny_holes(**params):
-    """The filter on pymeshlab's bunny (5,051 vertices, 5 holes at its base): its result, the
-    edge counts of the loops found at each true hole {hole: [edges]}, and those of the loops far
-    from every true hole."""
+def bunny_holes(mesh=False, **params):
+    """The filter on pymeshlab's bunny (5,051 vertices, 5 holes at its base), as a point cloud
+    or (mesh=True) as the mesh a MeshLab user loads: its result, the edge counts of the loops
+    found at each true hole {hole: [edges]}, and those of the loops far from every true hole."""
     points, normals = point_cloud(SAMPLES / "bunny10k_textured.obj")
     _, faces = read_mesh(SAMPLES / "bunny10k_textured.obj")  # the same vertices, in the same order
     true_holes = boundary_vertex_sets(faces, len(points))
     assert len(true_holes) == 5
-    ms = new_set(points, normals)
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=points, face_matrix=faces, v_normals_matrix=normals) if mesh
+                else pymeshlab.Mesh(vertex_matrix=points, v_normals_matrix=normals), "bunny")
     result = getattr(ms, FILTER)(**params)
     out = ms.current_mesh().vertex_matrix()
     loops = implicit_boundaries.loops_from_result(result)
@@ -98,6 +100,32 @@ def test_bunny_scan_keeps_its_real_holes(plugin):
     assert len(found) >= 3 and sum(max(v) >= 15 for v in found.values()) >= 2
     assert result["holes_filled"] > 0  # the undersampling gaps, filled by min_boundary_edges
     assert result["seam_points"] == 0
+
+
+def test_bunny_mesh_keeps_exactly_its_five_holes(plugin):
+    """Given as the mesh it is, the bunny's triangles say where its two slits are (from the
+    vertices alone they are no deeper than the gaps between samples): each of the 5 holes comes
+    out as one loop at its place, and there is no other loop. With keep_mesh_holes off the
+    faces are ignored, as for the point cloud (fewer holes kept)."""
+    result, found, spurious = bunny_holes(mesh=True)
+    assert not spurious, f"loops of {spurious} edges far from every real hole"
+    assert sorted(found) == [0, 1, 2, 3, 4] and all(len(v) == 1 for v in found.values()), found
+    assert result["boundary_loops"] == 5 and result["faces_cut_at_mesh_holes"] > 0
+    ignored, found_ignored, _ = bunny_holes(mesh=True, keep_mesh_holes=False)
+    assert ignored["faces_cut_at_mesh_holes"] == 0 and len(found_ignored) < 5
+
+
+def test_a_layer_of_zero_area_faces_says_what_to_do(plugin):
+    points, normals = point_cloud(SAMPLES / "bunny10k_textured.obj")
+    flat = np.repeat(np.arange(10, dtype=np.int32)[:, None], 3, axis=1)  # each face one vertex three times
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=points, face_matrix=flat, v_normals_matrix=normals), "points")
+    with pytest.raises(pymeshlab.PyMeshLabException, match="Every face of the layer has zero area: remove the faces"):
+        getattr(ms, FILTER)()
+    assert ms.mesh_number() == 1
+    assert getattr(ms, FILTER)(keep_mesh_holes=False)["faces_cut_at_mesh_holes"] == 0
+    with pytest.raises(ValueError, match="faces refer to vertices outside"):
+        implicit_boundaries.reconstruct(points, normals, faces=[[0, 1, len(points)]])
 
 
 @pytest.mark.parametrize("implicit", [Implicit.PU_RBF, Implicit.HOPPE])

@@ -2,15 +2,17 @@
 /// \file boundary_stage.h
 /// The boundary stage of the pipeline, on the gated extraction (surface faces first, then the
 /// hole faces marching cubes found closing each hole): decides which holes are undersampling
-/// and fills them (paper §3.1), cuts the surface at orientation seams, trims what the SODS
-/// added past the scan's edge, removes pinches and scraps, smooths the loops (paper §3.3) and
-/// fits them to the samples' edge.
+/// and fills them (paper §3.1), cuts the surface at orientation seams and where it passes
+/// over none of an input mesh's triangles, trims what the SODS added past the scan's edge,
+/// removes pinches and scraps, smooths the loops (paper §3.3) and fits them to the samples'
+/// edge.
 
 #include "boundaries.h"
 #include "boundary_fit.h"
 #include "boundary_smoothing.h"
 #include "boundary_trim.h"
 #include "gated_mc.h"
+#include "mesh_holes.h"
 #include "orientation_seam.h"
 #include "parallel.h"
 #include "pinches.h"
@@ -62,6 +64,9 @@ public:
         bool boundary_fit = true;
         /// The samples are several merged scans: gaps between their coverage are filled too.
         bool merged_scans = false;
+        /// The input's triangles (one scan given as a mesh), or null: the surface is cut where
+        /// it passes over none of them (mesh_holes.h). Not owned.
+        const MeshDistance* input_mesh = nullptr;
         /// The extraction is the closed full-lattice reference: nothing to fill, trim or smooth.
         bool reference = false;
         int min_support = 10;        ///< pieces supported by fewer samples are removed
@@ -81,6 +86,7 @@ public:
         int largest_hole_filled = 0;
         int smallest_hole_kept = 0;
         size_t faces_cut_at_seams = 0;    ///< surface faces removed around orientation seams
+        size_t faces_cut_at_mesh_holes = 0;  ///< surface faces over none of the input's triangles (mesh_holes.h)
         size_t faces_trimmed = 0;         ///< unsupported faces peeled off the boundary
         size_t faces_unpinched = 0;       ///< faces of smaller fans removed at pinch vertices
         size_t faces_unsupported = 0;     ///< faces of pieces supported by fewer than min_support samples
@@ -115,6 +121,9 @@ public:
         // After the filling, so that the cut is not taken for a small hole and closed again.
         r.faces_cut_at_seams =
             OrientationSeam::Cut(all, seam, kSeamRadius * p.sample_spacing, inSurface, p.threads);
+        if (p.input_mesh)
+            r.faces_cut_at_mesh_holes =
+                MeshHoles::Cut(all, *p.input_mesh, p.cell_size, p.min_boundary_edges, inSurface);
         if (p.boundary_trim > 0)
             r.faces_trimmed = BoundaryTrim::Compute(all, samples, p.boundary_trim * spacing, inSurface, p.threads);
         r.faces_unpinched = Pinches::Resolve(all, inSurface);

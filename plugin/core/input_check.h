@@ -63,6 +63,15 @@ struct InputCheck
             throw InputError("The scans' sizes must add up to the number of vertices.");
     }
 
+    /// Throws InputError unless every index of the m×3 faces F is a row of P.
+    static void FacesOf(const Points& P, const Faces& F)
+    {
+        const Eigen::Index bad = ((F.array() < 0) || (F.array() >= P.rows())).rowwise().any().count();
+        if (bad > 0)
+            throw InputError(std::to_string(bad) + " of " + std::to_string(F.rows()) + " faces refer to vertices " +
+                             "the layer does not have.");
+    }
+
     /// Indices of the rows of P, in order, skipping rows equal to an earlier one.
     static std::vector<Eigen::Index> DistinctRows(const Points& P)
     {

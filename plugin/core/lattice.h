@@ -11,6 +11,8 @@ namespace ib {
 
 /// n×3 point set, one point per row (rows are contiguous, so rows can be viewed as vcg::Point3d).
 using Points = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
+/// m×3 vertex indices (rows of a Points) of triangles, one row per face.
+using Faces = Eigen::Matrix<int, Eigen::Dynamic, 3, Eigen::RowMajor>;
 
 /// Integer cell or corner coordinates.
 using Index3 = Eigen::Vector3i;

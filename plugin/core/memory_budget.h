@@ -34,6 +34,9 @@ struct MemoryBudget
     /// points projected onto the zero set and the PU-RBF's octree and local fits (one per 20 to
     /// 60 samples; the PU-RBF stage grows the process by about 1 GB of the 2.7 GB peak at 5M).
     static constexpr double kBytesPerSample = 380;
+    /// Per face of an input mesh (mesh_holes.h): its copy with adjacency and normals, its share
+    /// of the vertices' copy and VCGlib's grid over the faces.
+    static constexpr double kBytesPerInputFace = 150;
     /// Thread stacks, the allocator's arenas, small tables.
     static constexpr double kBytesFixed = 30e6;
 
@@ -44,23 +47,24 @@ struct MemoryBudget
         return pages > 0 && page > 0 ? 0.5 * double(pages) * double(page) : 4e9;
     }
 
-    /// Estimated peak bytes of a run over `samples` input samples and an extraction over
-    /// `sodsCells` cells, plus a dense array of `denseCorners` values (0 for the SODS-driven
-    /// extraction). The host's own copy of the layer is not counted: it exists before the run.
-    static double PeakBytes(double samples, double sodsCells, double denseCorners)
+    /// Estimated peak bytes of a run over `samples` input samples (and the `faces` of an input
+    /// mesh) and an extraction over `sodsCells` cells, plus a dense array of `denseCorners`
+    /// values (0 for the SODS-driven extraction). The host's own copy of the layer is not counted: it exists before the run.
+    static double PeakBytes(double samples, double sodsCells, double denseCorners, double faces = 0)
     {
-        return kBytesFixed + kBytesPerSample * samples + kBytesPerSodsCell * sodsCells + 8.0 * denseCorners;
+        return kBytesFixed + kBytesPerSample * samples + kBytesPerSodsCell * sodsCells + 8.0 * denseCorners +
+               kBytesPerInputFace * faces;
     }
     /// Refuses, before allocating, a run at `resolution` whose estimated peak (PeakBytes over
-    /// `samples`, and `sodsCells` or, for a `dense` extraction, the lattice's `denseCorners`)
+    /// `samples` and `faces`, and `sodsCells` or, for a `dense` extraction, the lattice's `denseCorners`)
     /// exceeds `limit` bytes: throws InputError with what to change. Returns the estimate.
     static double Check(double samples, double sodsCells, bool dense, double denseCorners, double limit,
-                        int resolution)
+                        int resolution, double faces = 0)
     {
-        const double bytes = PeakBytes(samples, sodsCells, dense ? denseCorners : 0);
+        const double bytes = PeakBytes(samples, sodsCells, dense ? denseCorners : 0, faces);
         if (bytes <= limit)
             return bytes;
-        const double sampleBytes = PeakBytes(samples, 0, 0);
+        const double sampleBytes = PeakBytes(samples, 0, 0, faces);
         std::ostringstream msg;
         msg.precision(2);
         msg << std::fixed << "Resolution " << resolution << " would need about " << bytes / 1e9

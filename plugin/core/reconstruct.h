@@ -97,6 +97,9 @@ public:
         /// apart by the registration error (the 9 Stanford bunny scans: 0.00044 over all of
         /// them, about a third of a scan's own spacing, and sheets up to 0.0006 apart).
         std::vector<Eigen::Index> scan_sizes;
+        /// m×3 rows of the input (one scan given as a triangle mesh), or empty (a point cloud):
+        /// the holes of the triangulation stay open, as their rims say (mesh_holes.h).
+        Faces faces;
     };
 
     struct Result
@@ -157,6 +160,7 @@ private:
                       CoreMesh* holes, vcg::CallBackPos* cb)
     {
         InputCheck::Samples(input, inputNormals, p.facing, p.scan_sizes);
+        InputCheck::FacesOf(input, p.faces);
         CheckParam(p);
         Result r;
         // Repeated samples (merged scans, exported meshes with seams) would make every
@@ -209,6 +213,7 @@ private:
         const double expectedCells = double(P.rows()) * std::pow(r.sample_spacing / cell, 2) *
                                      std::max(2.0, 2 * kSlabPerSpacing * r.sample_spacing / cell);
         r.memory_estimate = CheckMemory(p, lattice, double(input.rows()), expectedCells, r);
+        const std::unique_ptr<MeshDistance> triangles = InputTriangles(input, p);
         const std::unique_ptr<ImplicitFunction> fitted =
             p.implicit == Implicit::Given ? nullptr : MakeImplicit(normals, samples, spacing, scan, p, r, cb);
         const ImplicitFunction& f = fitted ? *fitted : *p.given;
@@ -258,7 +263,8 @@ private:
         const Points seam = OrientationSeam::Find(samples, normals, spacing, foldWidth, p.threads, scan);
         r.seam_points = size_t(seam.rows());
         std::vector<char> inSurface;
-        r.boundary = BoundaryStage::Compute(surface, mc, samples, spacing, seam, f, BoundaryParam(p, r), inSurface);
+        r.boundary = BoundaryStage::Compute(surface, mc, samples, spacing, seam, f, BoundaryParam(p, r, triangles.get()),
+                                            inSurface);
         if (holes)
             BoundaryStage::SplitHoles(surface, inSurface, *holes);
         BoundaryStage::KeepSurface(surface, inSurface);
@@ -331,10 +337,26 @@ private:
         return normals;
     }
 
-    /// The boundary stage's parameters from the pipeline's, on the lattice and spacing of r.
-    static BoundaryStage::Param BoundaryParam(const Param& p, const Result& r)
+    /// The input's triangles (p.faces over the input's rows) for the boundary stage, or null
+    /// for a point cloud.
+    static std::unique_ptr<MeshDistance> InputTriangles(const Points& input, const Param& p)
+    {
+        if (!p.faces.rows())
+            return nullptr;
+        try {
+            return std::make_unique<MeshDistance>(input, p.faces, p.threads);
+        } catch (const std::invalid_argument&) {  // only zero-area faces
+            throw InputError("Every face of the layer has zero area: remove the faces (keep the vertices) or turn "
+                             "'Keep the mesh's holes' off.");
+        }
+    }
+
+    /// The boundary stage's parameters from the pipeline's, on the lattice and spacing of r;
+    /// `triangles`: the input's (InputTriangles), or null.
+    static BoundaryStage::Param BoundaryParam(const Param& p, const Result& r, const MeshDistance* triangles)
     {
         BoundaryStage::Param bp;
+        bp.input_mesh = triangles;
         bp.min_boundary_edges = p.min_boundary_edges;
         bp.boundary_trim = p.boundary_trim;
         bp.boundary_smoothing = p.boundary_smoothing;
@@ -354,7 +376,7 @@ private:
                               const Result& r)
     {
         return MemoryBudget::Check(samples, sodsCells, p.extraction != GatedMarchingCubes::Extraction::SodsDriven,
-                                   lattice.CornerCount(), r.memory_limit, r.resolution);
+                                   lattice.CornerCount(), r.memory_limit, r.resolution, double(p.faces.rows()));
     }
 
     /// Throws InputError when a parameter is out of its range.

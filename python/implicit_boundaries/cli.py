@@ -137,7 +137,8 @@ def cmd_compare(args) -> int:
 
 
 def cmd_demo(args) -> int:
-    print(f"input: vertices and normals of {DEMO_SCAN} (pymeshlab's Stanford bunny, 5 holes at its base)")
+    print(f"input: {DEMO_SCAN} as MeshLab loads it (pymeshlab's Stanford bunny: vertices, normals and "
+          f"triangles; 5 holes at its base)")
     args.input = [DEMO_SCAN]
     cmd_reconstruct(args)
     print("comparing with MeshLab's screened Poisson, the scan's own mesh as ground truth")

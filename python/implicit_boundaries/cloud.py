@@ -13,9 +13,12 @@ from .options import NORMAL_NEIGHBOURS
 
 @dataclass
 class Cloud:
-    """The input: (n, 3) points and (n, 3) unit normals (oriented outwards)."""
+    """The input: (n, 3) points and (n, 3) unit normals (oriented outwards), and the (f, 3)
+    vertex indices of its triangles when it is a mesh (None: a point cloud). The filter keeps
+    the holes of the triangles open ("Keep the mesh's holes")."""
     points: np.ndarray
     normals: np.ndarray
+    faces: Optional[np.ndarray] = None
 
     @property
     def diagonal(self) -> float:
@@ -44,8 +47,8 @@ def _load(path: Path) -> pymeshlab.MeshSet:
 
 
 def read_cloud(path: Union[str, Path], estimate_normals: bool = True) -> Cloud:
-    """The (n, 3) vertices and (n, 3) normals of any file pymeshlab reads, faces dropped (a
-    mesh file's normals are those MeshLab computes from its faces on loading).
+    """The (n, 3) vertices and (n, 3) normals of any file pymeshlab reads, and its faces when it
+    has some (a mesh file's normals are those MeshLab computes from its faces on loading).
 
     When the file has no normals: estimate_normals=True estimates them with MeshLab's point
     cloud normals over the filter's number of neighbours (what screened Poisson needs);
@@ -60,7 +63,8 @@ def read_cloud(path: Union[str, Path], estimate_normals: bool = True) -> Cloud:
     if estimate_normals and not np.any(mesh.vertex_normal_matrix()):
         ms.compute_normal_for_point_clouds(k=NORMAL_NEIGHBOURS)
         mesh = ms.current_mesh()
-    return Cloud(mesh.vertex_matrix().copy(), mesh.vertex_normal_matrix().copy())
+    faces = mesh.face_matrix().copy() if mesh.face_number() else None
+    return Cloud(mesh.vertex_matrix().copy(), mesh.vertex_normal_matrix().copy(), faces)
 
 
 def read_mesh(path: Union[str, Path]) -> Tuple[np.ndarray, np.ndarray]:
@@ -74,8 +78,13 @@ def read_mesh(path: Union[str, Path]) -> Tuple[np.ndarray, np.ndarray]:
 
 
 def add_layer(ms: pymeshlab.MeshSet, cloud: Cloud, name: str = "points", matrix: Optional[np.ndarray] = None) -> None:
-    """Adds the cloud to `ms` as a new current layer called `name`, with `matrix` (4, 4), the
-    transformation taking a scan to the common frame of several, as its layer matrix."""
-    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=cloud.points, v_normals_matrix=cloud.normals), name)
+    """Adds the cloud (and its faces, when it has some) to `ms` as a new current layer called
+    `name`, with `matrix` (4, 4), the transformation taking a scan to the common frame of
+    several, as its layer matrix."""
+    if cloud.faces is None:
+        mesh = pymeshlab.Mesh(vertex_matrix=cloud.points, v_normals_matrix=cloud.normals)
+    else:
+        mesh = pymeshlab.Mesh(vertex_matrix=cloud.points, face_matrix=cloud.faces, v_normals_matrix=cloud.normals)
+    ms.add_mesh(mesh, name)
     if matrix is not None:
         ms.set_matrix(transformmatrix=np.asarray(matrix, dtype=np.float64), freeze=False)

@@ -36,12 +36,16 @@ def loops_from_result(result: Dict[str, object]) -> List[np.ndarray]:
 
 
 def reconstruct(points, normals: Optional[np.ndarray] = None, estimate_normals: bool = False,
-                viewpoint: Optional[np.ndarray] = None, **params) -> Reconstruction:
+                viewpoint: Optional[np.ndarray] = None, faces: Optional[np.ndarray] = None,
+                **params) -> Reconstruction:
     """Reconstructs the surface with boundaries of the (n, 3) ``points``.
 
     normals: (n, 3) outward normals, or None to estimate them (as does estimate_normals=True
     when normals are given). viewpoint: (3,) the scanner's position: normals are estimated and
-    turned to face it (a single range scan), instead of oriented by propagation. params: the filter's other parameters by their pymeshlab names,
+    turned to face it (a single range scan), instead of oriented by propagation. faces: (f, 3)
+    vertex indices of the points' triangles when they are a mesh (a triangulated scan): every
+    hole of the triangles stays open, unless its loop is under min_boundary_edges (set
+    keep_mesh_holes=False to ignore them). params: the filter's other parameters by their pymeshlab names,
     e.g. resolution=128 (cells along the longest bounding-box side; 0, the default, chooses it
     from the sample spacing), sods_occupancy, sample_radius, sods_dilation, normal_neighbours;
     ``pymeshlab.print_filter_parameter_list(implicit_boundaries.FILTER_NAME)`` lists them.
@@ -49,13 +53,18 @@ def reconstruct(points, normals: Optional[np.ndarray] = None, estimate_normals: 
     """
     load()
     points = np.ascontiguousarray(points, dtype=np.float64).reshape(-1, 3)
-    if normals is None:
-        mesh = pymeshlab.Mesh(vertex_matrix=points)
-    else:
+    arrays = dict(vertex_matrix=points)
+    if normals is not None:
         normals = np.ascontiguousarray(normals, dtype=np.float64).reshape(-1, 3)
         if normals.shape != points.shape:
             raise ValueError(f"normals have shape {normals.shape}, points {points.shape}: one normal per point")
-        mesh = pymeshlab.Mesh(vertex_matrix=points, v_normals_matrix=normals)
+        arrays["v_normals_matrix"] = normals
+    if faces is not None:
+        faces = np.ascontiguousarray(faces, dtype=np.int32).reshape(-1, 3)
+        if len(faces) and (faces.min() < 0 or faces.max() >= len(points)):
+            raise ValueError(f"faces refer to vertices outside 0..{len(points) - 1}")
+        arrays["face_matrix"] = faces
+    mesh = pymeshlab.Mesh(**arrays)
     ms = pymeshlab.MeshSet()
     ms.add_mesh(mesh, "points")
     if viewpoint is not None:

@@ -18,6 +18,9 @@
 /// number would be exact far from the mesh but costs a pass over all faces per query.
 ///
 /// Sign convention (implicit_function.h): negative inside (against the face normals).
+///
+/// The same closest-point query tells how far a point lies past an open mesh's border
+/// (PastBorder), which keeps an input mesh's holes open (mesh_holes.h).
 
 #include "implicit_function.h"
 #include "../parallel.h"
@@ -65,7 +68,7 @@ public:
     /// V: n×3 vertex positions; F: m×3 vertex indices of triangles oriented outwards (normals
     /// by the right-hand rule point to the outside). Both are copied. Throws
     /// std::invalid_argument when no usable face remains or indices are out of range.
-    MeshDistance(const Points& V, const Eigen::Matrix<int, Eigen::Dynamic, 3, Eigen::RowMajor>& F, int threads = 0)
+    MeshDistance(const Points& V, const Faces& F, int threads = 0)
         : threads_(threads)
     {
         if (F.rows() == 0)
@@ -95,6 +98,8 @@ public:
         vcg::tri::UpdateTopology<DistanceMesh>::FaceFace(mesh_);
         int edges = 0;
         vcg::tri::Clean<DistanceMesh>::CountEdgeNum(mesh_, edges, stats_.border_edges, stats_.non_manifold_edges);
+        vcg::tri::UpdateFlags<DistanceMesh>::FaceBorderFromFF(mesh_);
+        vcg::tri::UpdateFlags<DistanceMesh>::VertexBorderFromFaceBorder(mesh_);
         vcg::tri::UpdateNormal<DistanceMesh>::PerFaceNormalized(mesh_);
         vcg::tri::UpdateNormal<DistanceMesh>::PerVertexAngleWeighted(mesh_);
         vcg::tri::UpdateNormal<DistanceMesh>::NormalizePerVertex(mesh_);
@@ -113,29 +118,36 @@ public:
         }, 256);
     }
 
+    /// Per row of the n×3 points Q, how far it lies past the mesh's border: the length of
+    /// p - q within the plane of the closest face, where q, p's closest point on the mesh, lies
+    /// on a border edge or vertex; 0 when q lies inside a face or on an edge or vertex inside
+    /// the mesh (p is over the mesh, at any height).
+    Eigen::VectorXd PastBorder(const Points& Q) const
+    {
+        Eigen::VectorXd past(Q.rows());
+        ParallelFor(size_t(Q.rows()), threads_, [&](size_t begin, size_t end, int) {
+            for (size_t i = begin; i < end; ++i)
+                past[Eigen::Index(i)] =
+                    PastBorderOne(vcg::Point3d(Q(Eigen::Index(i), 0), Q(Eigen::Index(i), 1), Q(Eigen::Index(i), 2)));
+        }, 256);
+        return past;
+    }
+
     const Stats& Statistics() const { return stats_; }
 
 private:
-    double EvalOne(const vcg::Point3d& p) const
+    /// The feature of face f its point q lies on, told by q's barycentric coordinates: a vertex
+    /// (its index in f), else an edge (edge e runs from vertex e to e + 1), else the face.
+    struct Feature
     {
-        vcg::face::PointDistanceBaseFunctor<double> distance;
-        vcg::tri::EmptyTMark<DistanceMesh> noMarks;
-        double d = maxDistance_;
-        vcg::Point3d q;
-        const DistanceFace* f = grid_.GetClosest(distance, noMarks, p, maxDistance_, d, q);
-        if (f == nullptr)  // cannot happen with a non-empty mesh and this search radius
-            return maxDistance_;
-        const vcg::Point3d n = PseudoNormal(*f, q);
-        return (p - q).dot(n) < 0 ? -d : d;
-    }
-
-    /// The angle-weighted pseudo-normal at q, the closest point of face f: the feature (face,
-    /// edge or vertex) q lies on is told by its barycentric coordinates.
-    static vcg::Point3d PseudoNormal(const DistanceFace& f, const vcg::Point3d& q)
+        int vertex = -1, edge = -1;
+    };
+    static Feature FeatureOf(const DistanceFace& f, const vcg::Point3d& q)
     {
+        Feature feature;
         vcg::Point3d b;
         if (!vcg::InterpolationParameters(f, f.cN(), q, b))
-            return f.cN();
+            return feature;
         const double eps = 1e-9;
         int zeros = 0, zero = -1, one = -1;
         for (int k = 0; k < 3; ++k) {
@@ -146,12 +158,55 @@ private:
                 one = k;
             }
         }
-        if (zeros >= 2)  // at vertex `one`
-            return f.cV(one)->cN();
-        if (zeros == 1) {  // on the edge opposite vertex `zero`: edge (zero + 1) -> (zero + 2)
-            const int e = (zero + 1) % 3;
-            return f.cN() + f.cFFp(e)->cN();  // a border edge's own face counts twice
-        }
+        if (zeros >= 2)
+            feature.vertex = one;
+        else if (zeros == 1)  // on the edge opposite vertex `zero`
+            feature.edge = (zero + 1) % 3;
+        return feature;
+    }
+
+    const DistanceFace* Closest(const vcg::Point3d& p, double& d, vcg::Point3d& q) const
+    {
+        vcg::face::PointDistanceBaseFunctor<double> distance;
+        vcg::tri::EmptyTMark<DistanceMesh> noMarks;
+        d = maxDistance_;
+        return grid_.GetClosest(distance, noMarks, p, maxDistance_, d, q);
+    }
+
+    double PastBorderOne(const vcg::Point3d& p) const
+    {
+        double d;
+        vcg::Point3d q(0, 0, 0);
+        const DistanceFace* f = Closest(p, d, q);
+        if (f == nullptr)
+            return 0;
+        const Feature at = FeatureOf(*f, q);
+        const bool border = at.vertex >= 0 ? f->cV(at.vertex)->IsB() : at.edge >= 0 && f->IsB(at.edge);
+        if (!border)
+            return 0;
+        const vcg::Point3d offset = p - q;
+        return (offset - f->cN() * offset.dot(f->cN())).Norm();
+    }
+
+    double EvalOne(const vcg::Point3d& p) const
+    {
+        double d;
+        vcg::Point3d q(0, 0, 0);
+        const DistanceFace* f = Closest(p, d, q);
+        if (f == nullptr)  // cannot happen with a non-empty mesh and this search radius
+            return maxDistance_;
+        const vcg::Point3d n = PseudoNormal(*f, q);
+        return (p - q).dot(n) < 0 ? -d : d;
+    }
+
+    /// The angle-weighted pseudo-normal at q, the closest point of face f.
+    static vcg::Point3d PseudoNormal(const DistanceFace& f, const vcg::Point3d& q)
+    {
+        const Feature at = FeatureOf(f, q);
+        if (at.vertex >= 0)
+            return f.cV(at.vertex)->cN();
+        if (at.edge >= 0)
+            return f.cN() + f.cFFp(at.edge)->cN();  // a border edge's own face counts twice
         return f.cN();
     }
 

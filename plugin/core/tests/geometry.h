@@ -7,6 +7,7 @@
 #include "implicit/implicit_function.h"
 
 #include <vcg/complex/algorithms/clean.h>
+#include <vcg/complex/algorithms/create/platonic.h>
 #include <vcg/complex/algorithms/update/topology.h>
 
 #include <algorithm>
@@ -86,6 +87,27 @@ inline void Grid(int n, double h, CoreMesh& m)
             vcg::tri::Allocator<CoreMesh>::AddFace(m, at(i, j), at(i + 1, j + 1), at(i, j + 1));
         }
     vcg::tri::UpdateTopology<CoreMesh>::FaceFace(m);
+}
+
+/// The vertex positions V (n×3) and faces F (m×3 rows of V) of m.
+inline void Matrices(const CoreMesh& m, Points& V, Faces& F)
+{
+    V.resize(Eigen::Index(m.vert.size()), 3);
+    for (size_t i = 0; i < m.vert.size(); ++i)
+        V.row(Eigen::Index(i)) << m.vert[i].cP()[0], m.vert[i].cP()[1], m.vert[i].cP()[2];
+    F.resize(Eigen::Index(m.face.size()), 3);
+    for (size_t i = 0; i < m.face.size(); ++i)
+        for (int k = 0; k < 3; ++k)
+            F(Eigen::Index(i), k) = int(vcg::tri::Index(m, m.face[i].cV(k)));
+}
+
+/// An icosphere of radius 1 (VCGlib's, subdivided `levels` times: 4 gives 2562 vertices and
+/// 5120 faces), outward-oriented.
+inline void Icosphere(Points& V, Faces& F, int levels = 4)
+{
+    CoreMesh m;
+    vcg::tri::Sphere(m, levels);
+    Matrices(m, V, F);
 }
 
 /// Exact signed distance to a sphere (negative inside).

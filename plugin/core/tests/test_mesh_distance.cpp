@@ -1,31 +1,14 @@
-// Signed distance to a mesh as the implicit function: an icosphere, with and without a crack.
+// Signed distance to a mesh as the implicit function: an icosphere, with and without a crack;
+// how far points lie past an open mesh's border.
 #include "geometry.h"
 #include "implicit/mesh_distance.h"
 #include "reconstruct.h"
-
-#include <vcg/complex/algorithms/create/platonic.h>
 
 #include <gtest/gtest.h>
 
 using namespace ib;
 
 namespace {
-using Faces = Eigen::Matrix<int, Eigen::Dynamic, 3, Eigen::RowMajor>;
-
-/// An icosphere of radius 1 (subdivided 4 times: 5120 faces), outward-oriented.
-void Icosphere(Points& V, Faces& F)
-{
-    CoreMesh m;
-    vcg::tri::Sphere(m, 4);
-    V.resize(Eigen::Index(m.vert.size()), 3);
-    for (size_t i = 0; i < m.vert.size(); ++i)
-        V.row(Eigen::Index(i)) << m.vert[i].cP()[0], m.vert[i].cP()[1], m.vert[i].cP()[2];
-    F.resize(Eigen::Index(m.face.size()), 3);
-    for (size_t i = 0; i < m.face.size(); ++i)
-        for (int k = 0; k < 3; ++k)
-            F(Eigen::Index(i), k) = int(vcg::tri::Index(m, m.face[i].cV(k)));
-}
-
 /// Points on random rays at the given radii.
 Points Shell(int n, double radius, unsigned seed)
 {
@@ -43,7 +26,7 @@ TEST(MeshDistance, IsTheSignedDistanceToAClosedMesh)
 {
     Points V;
     Faces F;
-    Icosphere(V, F);
+    test::Icosphere(V, F);
     const MeshDistance f(V, F);
     EXPECT_EQ(f.Statistics().border_edges, 0);
     for (double r : {0.3, 0.9, 0.99, 1.01, 1.2, 3.0}) {
@@ -61,7 +44,7 @@ TEST(MeshDistance, KeepsAUsableSignAcrossACrack)
     // Remove a strip of faces: the mesh is open, the sign must still be right near it.
     Points V;
     Faces F;
-    Icosphere(V, F);
+    test::Icosphere(V, F);
     std::vector<int> kept;
     for (Eigen::Index i = 0; i < F.rows(); ++i) {
         const Eigen::Vector3d c = (V.row(F(i, 0)) + V.row(F(i, 1)) + V.row(F(i, 2))).transpose() / 3;
@@ -99,7 +82,7 @@ TEST(MeshDistance, SamplesOnHalfTheSphereGiveOneLoopAtTheRim)
 {
     Points V;
     Faces F;
-    Icosphere(V, F);
+    test::Icosphere(V, F);
     const MeshDistance sphere(V, F);
     Points P, N;
     test::SpherePoints(4000, 1.0, P, N, 0.0);  // the upper half only
@@ -128,4 +111,32 @@ TEST(MeshDistance, SamplesOnHalfTheSphereGiveOneLoopAtTheRim)
 
     p.given = nullptr;
     EXPECT_THROW(Reconstruction::Compute(P, N, p, m), InputError);
+}
+
+TEST(MeshDistance, PastBorderIsTheInPlaneDistanceBeyondAnOpenEdge)
+{
+    // The unit square of two triangles in z = 0: its four edges are its border.
+    Points V(4, 3);
+    V << 0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0;
+    Faces F(2, 3);
+    F << 0, 1, 2, 0, 2, 3;
+    const MeshDistance square(V, F);
+    Points Q(5, 3);
+    Q << 0.5, 0.5, 0.8,   // over the inside, high above it
+        0.5, 0.5, -0.1,   // under it
+        0.5, 0.5, 0,      // on the diagonal, an edge both faces share
+        1.3, 0.5, 0.4,    // 0.3 past the edge x = 1, 0.4 above
+        -0.3, -0.4, 0;    // 0.5 past the corner at the origin
+    const Eigen::VectorXd past = square.PastBorder(Q);
+    EXPECT_EQ(past[0], 0);
+    EXPECT_EQ(past[1], 0);
+    EXPECT_EQ(past[2], 0);
+    EXPECT_NEAR(past[3], 0.3, 1e-12);
+    EXPECT_NEAR(past[4], 0.5, 1e-12);
+
+    // On a closed mesh nothing is past the border.
+    Points S;
+    Faces T;
+    test::Icosphere(S, T, 2);
+    EXPECT_EQ(MeshDistance(S, T).PastBorder(Shell(200, 1.5, 3)).maxCoeff(), 0);
 }

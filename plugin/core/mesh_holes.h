@@ -1,0 +1,88 @@
+#pragma once
+/// \file mesh_holes.h
+/// Holes of an input mesh kept open. From its samples alone a small hole cannot be told from
+/// undersampling: pymeshlab's bunny has two holes 1.03 and 1.27 spacings deep, no deeper than
+/// the largest gaps between its own vertices (BENCHMARKS, "Small real holes"), and the tangent
+/// disks close them. When the input is a triangle mesh (a triangulated range scan, a mesh
+/// being remeshed), its triangles record where the surface was seen, so a hole of the
+/// triangulation is a hole: the extracted surface is cut where it passes over none of the
+/// input's triangles. The hole rule of point clouds still applies to what the cut opens: an
+/// opening whose loop has fewer than min_boundary_edges edges is undersampling, and stays
+/// closed.
+
+#include "implicit/mesh_distance.h"
+#include "mesh.h"
+
+#include <vector>
+
+namespace ib {
+
+class MeshHoles
+{
+public:
+    /// A face is over the input mesh when its centre lies at most this many cells past the
+    /// mesh's border: marching cubes faces lie within a cell, so a face crossing the border
+    /// has its centre within half a cell of it.
+    static constexpr double kPastBorderCells = 0.5;
+
+    /// Removes from the surface (inSurface[f] = 1; face-face adjacency of `all` up to date)
+    /// the faces whose centre lies more than kPastBorderCells × cellSize past the border of
+    /// `input` (MeshDistance::PastBorder), except the openings inside the surface whose loop
+    /// would have fewer than minEdges edges (0: none kept closed). Returns the faces removed.
+    static size_t Cut(const CoreMesh& all, const MeshDistance& input, double cellSize, int minEdges,
+                      std::vector<char>& inSurface)
+    {
+        std::vector<size_t> surface;
+        for (size_t f = 0; f < all.face.size(); ++f)
+            if (inSurface[f])
+                surface.push_back(f);
+        Points centres(Eigen::Index(surface.size()), 3);
+        for (size_t k = 0; k < surface.size(); ++k) {
+            const vcg::Point3d c = vcg::Barycenter(all.face[surface[k]]);
+            centres.row(Eigen::Index(k)) << c[0], c[1], c[2];
+        }
+        const Eigen::VectorXd past = input.PastBorder(centres);
+        std::vector<char> over(all.face.size(), 0);  // 1: past the border
+        for (size_t k = 0; k < surface.size(); ++k)
+            over[surface[k]] = past[Eigen::Index(k)] > kPastBorderCells * cellSize;
+
+        // Each connected piece of faces past the border: cut, unless it lies inside the surface
+        // and its rim would be a loop of fewer than minEdges edges.
+        size_t removed = 0;
+        std::vector<char> seen(all.face.size(), 0);
+        std::vector<size_t> piece, stack;
+        for (size_t start : surface) {
+            if (!over[start] || seen[start])
+                continue;
+            piece.clear();
+            stack.assign(1, start);
+            seen[start] = 1;
+            bool atBoundary = false;
+            int rim = 0;
+            while (!stack.empty()) {
+                const size_t f = stack.back();
+                stack.pop_back();
+                piece.push_back(f);
+                for (int i = 0; i < 3; ++i) {
+                    const size_t g = vcg::tri::Index(all, all.face[f].cFFp(i));
+                    if (g == f || !inSurface[g]) {
+                        atBoundary = true;
+                    } else if (!over[g]) {
+                        ++rim;
+                    } else if (!seen[g]) {
+                        seen[g] = 1;
+                        stack.push_back(g);
+                    }
+                }
+            }
+            if (!atBoundary && rim < minEdges)
+                continue;
+            for (size_t f : piece)
+                inSurface[f] = 0;
+            removed += piece.size();
+        }
+        return removed;
+    }
+};
+
+} // namespace ib

@@ -1,0 +1,112 @@
+// Holes of an input mesh kept open: a wavy sheet given as a triangle mesh, with holes smaller
+// than the tangent disks bridge.
+#include "geometry.h"
+#include "reconstruct.h"
+
+#include <gtest/gtest.h>
+
+using namespace ib;
+
+namespace {
+
+/// A wavy sheet over [0, 1]^2 triangulated on a grid of 40 × 40 squares (spacing 0.025), with
+/// the vertices within `hole` of (0.5, 0.5) (in the plane) and their faces left out; unit
+/// normals N.
+void HoledSheet(double hole, Points& V, Points& N, Faces& F)
+{
+    const int n = 40;
+    const double h = 1.0 / n;
+    auto z = [](double x, double y) { return 0.05 * std::sin(4 * x) * std::cos(3 * y); };
+    std::vector<int> row(size_t((n + 1) * (n + 1)), -1);
+    std::vector<Eigen::Vector3d> ps, ns;
+    for (int j = 0; j <= n; ++j)
+        for (int i = 0; i <= n; ++i) {
+            const double x = i * h, y = j * h;
+            if (std::hypot(x - 0.5, y - 0.5) < hole)
+                continue;
+            row[size_t(j * (n + 1) + i)] = int(ps.size());
+            ps.emplace_back(x, y, z(x, y));
+            const double dx = 0.2 * std::cos(4 * x) * std::cos(3 * y), dy = -0.15 * std::sin(4 * x) * std::sin(3 * y);
+            ns.push_back(Eigen::Vector3d(-dx, -dy, 1).normalized());
+        }
+    std::vector<Eigen::Vector3i> fs;
+    auto at = [&](int i, int j) { return row[size_t(j * (n + 1) + i)]; };
+    for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) {
+            const int a = at(i, j), b = at(i + 1, j), c = at(i + 1, j + 1), d = at(i, j + 1);
+            if (a >= 0 && b >= 0 && c >= 0)
+                fs.emplace_back(a, b, c);
+            if (a >= 0 && c >= 0 && d >= 0)
+                fs.emplace_back(a, c, d);
+        }
+    V.resize(Eigen::Index(ps.size()), 3);
+    N.resize(Eigen::Index(ps.size()), 3);
+    F.resize(Eigen::Index(fs.size()), 3);
+    for (size_t k = 0; k < ps.size(); ++k) {
+        V.row(Eigen::Index(k)) = ps[k].transpose();
+        N.row(Eigen::Index(k)) = ns[k].transpose();
+    }
+    for (size_t k = 0; k < fs.size(); ++k)
+        F.row(Eigen::Index(k)) = fs[k].transpose();
+}
+
+size_t Loops(const Points& V, const Points& N, const Faces& F, int minEdges = BoundaryStage::kDefaultMinBoundaryEdges)
+{
+    Reconstruction::Param p;
+    p.faces = F;
+    p.min_boundary_edges = minEdges;
+    CoreMesh m;
+    const Reconstruction::Result r = Reconstruction::Compute(V, N, p, m);
+    const test::Topology t = test::Check(m);
+    EXPECT_EQ(t.non_manifold_edges, 0);
+    EXPECT_TRUE(t.oriented);
+    return r.loops.size();
+}
+
+} // namespace
+
+TEST(MeshHoles, AHoleOfTheTriangulationStaysOpenWhereTheDisksBridgeIt)
+{
+    Points V, N;
+    Faces F;
+    HoledSheet(0.05, V, N, F);  // an empty circle of about two spacings
+    EXPECT_EQ(Loops(V, N, Faces()), 1u) << "as a point cloud the hole is undersampling";
+    EXPECT_EQ(Loops(V, N, F), 2u) << "the mesh says it is a hole";
+}
+
+TEST(MeshHoles, AMissingVertexIsUndersamplingAsInAPointCloud)
+{
+    Points V, N;
+    Faces F;
+    HoledSheet(0.01, V, N, F);  // one vertex and its six faces
+    ASSERT_EQ(V.rows(), 41 * 41 - 1);
+    EXPECT_EQ(Loops(V, N, F), 1u) << "its opening has fewer than min_boundary_edges edges";
+    EXPECT_EQ(Loops(V, N, F, 0), 2u) << "min_boundary_edges 0 keeps every hole";
+}
+
+TEST(MeshHoles, AClosedMeshStaysClosed)
+{
+    Points V, N;
+    Faces F;
+    test::Icosphere(V, F);
+    N = V.rowwise().normalized();
+    EXPECT_EQ(Loops(V, N, F), 0u);
+}
+
+TEST(MeshHoles, FacesOutsideTheLayerAreRefused)
+{
+    Points V, N;
+    Faces F;
+    HoledSheet(0.05, V, N, F);
+    F(3, 1) = int(V.rows());
+    Reconstruction::Param p;
+    p.faces = F;
+    CoreMesh m;
+    try {
+        Reconstruction::Compute(V, N, p, m);
+        FAIL() << "accepted a face index past the last vertex";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("1 of " + std::to_string(F.rows()) + " faces refer to vertices"),
+                  std::string::npos) << e.what();
+    }
+}
