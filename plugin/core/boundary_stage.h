@@ -65,7 +65,7 @@ public:
         /// The samples are several merged scans: gaps between their coverage are filled too.
         bool merged_scans = false;
         /// The input's triangles (one scan given as a mesh), or null: the surface is cut where
-        /// it passes over none of them (mesh_holes.h). Not owned.
+        /// it passes over none of them, and holes they cover are filled (mesh_holes.h). Not owned.
         const MeshDistance* input_mesh = nullptr;
         /// The extraction is the closed full-lattice reference: nothing to fill, trim or smooth.
         bool reference = false;
@@ -113,7 +113,7 @@ public:
         // gap between the scans' coverage, filled whatever its loops' size.
         const std::vector<int> fill = SmallHoles(all, inSurface, mc, p.min_boundary_edges,
                                                  p.merged_scans ? &samples : nullptr, spacing, p.threads,
-                                                 r.loops_before_filling, &r);
+                                                 r.loops_before_filling, &r, p.input_mesh, p.cell_size);
         for (size_t face = mc.surface_faces; face < all.face.size(); ++face)
             if (fill[size_t(mc.face_region[face - mc.surface_faces])])
                 inSurface[face] = 1;
@@ -153,12 +153,15 @@ public:
     /// gap by a detour far from every sample, a torn tip whose fit bulges away, many more), and
     /// small: every loop along it has fewer than `min_edges` edges, or, with `coverage` (the
     /// samples of merged scans, their local `spacing`; null: no such rule), none of it is
-    /// farther than kCoverageGap spacings from them. Also reports the edge counts of all loops
-    /// and, in `margins` (may be null), largest_hole_filled and smallest_hole_kept.
+    /// farther than kCoverageGap spacings from them, or, with `mesh` (the input's triangles;
+    /// null: none), all of it lies over them (MeshHoles::Covered, on a lattice of `cellSize`).
+    /// Also reports the edge counts of all loops and, in `margins` (may be null),
+    /// largest_hole_filled and smallest_hole_kept.
     static std::vector<int> SmallHoles(const CoreMesh& all, const std::vector<char>& inSurface,
                                        const GatedMarchingCubes::Result& mc, int min_edges,
                                        const SampleIndex* coverage, const Eigen::VectorXd& spacing, int threads,
-                                       std::vector<int>& loopEdges, Result* margins = nullptr)
+                                       std::vector<int>& loopEdges, Result* margins = nullptr,
+                                       const MeshDistance* mesh = nullptr, double cellSize = 0)
     {
         std::vector<int> fill(mc.region_closed.begin(), mc.region_closed.end());
         std::vector<double> edges(fill.size(), 0), faces(fill.size(), 0), longest(fill.size(), 0);
@@ -190,6 +193,12 @@ public:
             const std::vector<double> depth = RegionDepths(all, mc, candidate, *coverage, spacing, threads);
             for (size_t i = 0; i < fill.size(); ++i)
                 fill[i] = fill[i] || (candidate[i] && depth[i] <= kCoverageGap);
+        }
+        if (mesh) {
+            const std::vector<char> covered =
+                MeshHoles::Covered(all, mc.surface_faces, mc.face_region, candidate, *mesh, cellSize);
+            for (size_t i = 0; i < fill.size(); ++i)
+                fill[i] = fill[i] || covered[i];
         }
         for (size_t i = 0; margins && i < fill.size(); ++i) {
             if (fill[i] && !candidate[i])

@@ -8,7 +8,9 @@
 /// triangulation is a hole: the extracted surface is cut where it passes over none of the
 /// input's triangles. The hole rule of point clouds still applies to what the cut opens: an
 /// opening whose loop has fewer than min_boundary_edges edges is undersampling, and stays
-/// closed.
+/// closed. The other way round, a hole the gate opened where the triangles cover the surface
+/// (the implicit surface bulging past a thin part's samples, a sparse occluded region) is no
+/// hole of the scan, and is filled whatever its size (Covered).
 
 #include "implicit/mesh_distance.h"
 #include "mesh.h"
@@ -24,6 +26,29 @@ public:
     /// mesh's border: marching cubes faces lie within a cell, so a face crossing the border
     /// has its centre within half a cell of it.
     static constexpr double kPastBorderCells = 0.5;
+
+    /// Per hole region of `all` with regions[r] set (its hole faces are all.face[surfaceFaces +
+    /// i] with faceRegion[i] == r), 1 if the centre of each of its faces lies over `input` (at
+    /// most kPastBorderCells × cellSize past its border).
+    static std::vector<char> Covered(const CoreMesh& all, size_t surfaceFaces, const std::vector<int>& faceRegion,
+                                     const std::vector<char>& regions, const MeshDistance& input, double cellSize)
+    {
+        std::vector<size_t> faces;
+        for (size_t i = 0; i < faceRegion.size(); ++i)
+            if (regions[size_t(faceRegion[i])])
+                faces.push_back(i);
+        Points centres(Eigen::Index(faces.size()), 3);
+        for (size_t k = 0; k < faces.size(); ++k) {
+            const vcg::Point3d c = vcg::Barycenter(all.face[surfaceFaces + faces[k]]);
+            centres.row(Eigen::Index(k)) << c[0], c[1], c[2];
+        }
+        const Eigen::VectorXd past = input.PastBorder(centres);
+        std::vector<char> covered(regions);
+        for (size_t k = 0; k < faces.size(); ++k)
+            if (past[Eigen::Index(k)] > kPastBorderCells * cellSize)
+                covered[size_t(faceRegion[faces[k]])] = 0;
+        return covered;
+    }
 
     /// Removes from the surface (inSurface[f] = 1; face-face adjacency of `all` up to date)
     /// the faces whose centre lies more than kPastBorderCells × cellSize past the border of

@@ -110,3 +110,28 @@ TEST(MeshHoles, FacesOutsideTheLayerAreRefused)
                   std::string::npos) << e.what();
     }
 }
+
+TEST(MeshHoles, CoveredTellsHoleRegionsOverTheMeshFromThosePastItsBorder)
+{
+    // The input: the unit square in z = 0. The extraction: a grid over [0, 1.5] x [0, 1] in
+    // z = 0.1 whose faces are all hole faces, region 0 left of x = 0.9 (over the square), region
+    // 1 right of x = 1.1 (past its border), region 2 across the border.
+    Points V(4, 3);
+    V << 0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0;
+    Faces F(2, 3);
+    F << 0, 1, 2, 0, 2, 3;
+    const MeshDistance square(V, F);
+    CoreMesh all;
+    test::Grid(30, 0.05, all);
+    std::vector<int> region;
+    for (const CoreFace& f : all.face) {
+        const vcg::Point3d c = vcg::Barycenter(f);
+        region.push_back(c[1] > 0.5 ? 2 : c[0] < 0.9 ? 0 : c[0] > 1.1 ? 1 : 2);
+    }
+    for (CoreVertex& v : all.vert)
+        v.P()[2] = 0.1;
+    const std::vector<char> covered = MeshHoles::Covered(all, 0, region, {1, 1, 1}, square, 0.05);
+    EXPECT_EQ(covered, (std::vector<char>{1, 0, 0}));
+    EXPECT_EQ(MeshHoles::Covered(all, 0, region, {0, 1, 1}, square, 0.05), (std::vector<char>{0, 0, 0}))
+        << "only the regions asked about";
+}
