@@ -50,6 +50,7 @@ DOCUMENTED_REFUSALS = [
     r"The PU-RBF's overlap must be between", r"The PU-RBF's off-surface distance must be above 0",
     r"The memory limit cannot be negative", r"Resolution \d+ would need about \S+ GB of memory",
     r"No surface was extracted at resolution \d+", r"The implicit mesh layer '[^']*' (has no faces|cannot be used)",
+    r"Every face of the layer has zero area",
 ]
 
 

@@ -32,6 +32,10 @@ MESHES = sorted(str(p.relative_to(DATA)) for p in DATA.glob("**/*") if p.suffix 
 
 SHAPES = ["cluster", "plane", "line", "sphere", "noise", "point"]
 NORMALS = ["none", "true", "random", "zero", "some zero", "some nan"]
+# Faces of the points' layer (keep_mesh_holes): none (a point cloud), triangles of nearby
+# samples (a mesh, with whatever holes and folds that makes), random index triples (slivers
+# across everything), or faces of one vertex three times (zero area: refused).
+FACES = ["none", "none", "none", "nearby", "random", "degenerate"]
 
 
 # ---------------------------------------------------------------------------------------------
@@ -136,6 +140,24 @@ def build_cloud(recipe):
     return points, normals
 
 
+def build_faces(recipe, points):
+    """The (f, 3) faces recipe["faces"] asks for over `points` (rows as build_cloud's), or None."""
+    mode = recipe.get("faces", "none")
+    n = len(points)
+    if mode == "none" or n < 3:
+        return None
+    rng = np.random.default_rng(recipe["seed"] + 2)
+    if mode == "random":
+        return rng.integers(0, n, (max(1, n // 2), 3)).astype(np.int32)
+    if mode == "degenerate":
+        return np.repeat(rng.integers(0, n, (max(1, n // 10), 1)), 3, axis=1).astype(np.int32)
+    from scipy.spatial import cKDTree
+    finite = np.where(np.isfinite(points).all(axis=1), 0, 1)[:, None] * 1e300  # NaN rows far away
+    _, near = cKDTree(np.nan_to_num(points) + finite).query(np.nan_to_num(points), k=min(3, n))
+    faces = near[:, :3] if near.shape[1] == 3 else np.zeros((0, 3), int)
+    return faces[(faces[:, 0] != faces[:, 1]) & (faces[:, 1] != faces[:, 2]) & (faces[:, 0] != faces[:, 2])].astype(np.int32)
+
+
 def split_into_scans(recipe, points, normals):
     """The cloud as recipe["scans"] overlapping range scans: bands along a random axis that
     overlap by a tenth of the extent, each shifted by a registration error of 0.1% of the
@@ -183,6 +205,7 @@ def clouds(draw, max_points=MAX_POINTS):
         "nans": draw(st.sampled_from([0] * 8 + [1, 5])),  # mostly clean: NaNs are refused up front
         "normals": draw(st.sampled_from(NORMALS)),
         "scans": draw(st.sampled_from([1, 1, 1, 2, 3])),  # merged as visible layers when more than 1
+        "faces": draw(st.sampled_from(FACES)),
         "seed": draw(st.integers(0, 2**32 - 1)),
     }
 

@@ -26,7 +26,7 @@ from hypothesis import event, given
 
 from implicit_boundaries.options import Extraction, Implicit, Normals, SodsOccupancy
 from fuzz_checks import DOCUMENTED_REFUSALS, check_answer
-from fuzz_inputs import SETTINGS, build_cloud, clouds, flat_scan, parameters, split_into_scans, with_row
+from fuzz_inputs import SETTINGS, build_cloud, build_faces, clouds, flat_scan, parameters, split_into_scans, with_row
 
 # A run that takes longer than this is a hang (the largest fuzz example takes a few seconds).
 CHILD_TIMEOUT = 600
@@ -50,10 +50,10 @@ def _serve(conn):
             conn.send({"status": "harness error", "message": traceback.format_exc()})
 
 
-def _run(pymeshlab, implicit_boundaries, points, normals, params, mesh_layer=None, scans=None):
-    """One filter call on a new MeshSet holding the points (layer 0) and, when given, a mesh
-    (vertices, faces) as layer 1 for the implicit_mesh parameter; or, with `scans`, one layer
-    per scan (points, normals or None, 4×4 matrix), merged by the filter."""
+def _run(pymeshlab, implicit_boundaries, points, normals, params, mesh_layer=None, scans=None, faces=None):
+    """One filter call on a new MeshSet holding the points (layer 0; with `faces`, a mesh) and,
+    when given, a mesh (vertices, faces) as layer 1 for the implicit_mesh parameter; or, with
+    `scans`, one layer per scan (points, normals or None, 4×4 matrix), merged by the filter."""
     ms = pymeshlab.MeshSet()
     if scans:
         for i, (p, n, matrix) in enumerate(scans):
@@ -68,10 +68,13 @@ def _run(pymeshlab, implicit_boundaries, points, normals, params, mesh_layer=Non
                 f.write("ply\nformat ascii 1.0\nelement vertex 0\nproperty double x\nproperty double y\n"
                         "property double z\nend_header\n")
             ms.load_new_mesh(empty)
-    elif normals is None:
-        ms.add_mesh(pymeshlab.Mesh(vertex_matrix=points), "points")
     else:
-        ms.add_mesh(pymeshlab.Mesh(vertex_matrix=points, v_normals_matrix=normals), "points")
+        arrays = {"vertex_matrix": points}
+        if normals is not None:
+            arrays["v_normals_matrix"] = normals
+        if faces is not None and len(faces):
+            arrays["face_matrix"] = faces
+        ms.add_mesh(pymeshlab.Mesh(**arrays), "points")
     if mesh_layer is not None:
         ms.add_mesh(pymeshlab.Mesh(vertex_matrix=mesh_layer[0], face_matrix=mesh_layer[1]), "mesh")
         ms.set_current_mesh(0)
@@ -102,10 +105,10 @@ class Worker:
         self.process.start()
         child_end.close()
 
-    def run(self, points, normals, params, mesh_layer=None, scans=None):
+    def run(self, points, normals, params, mesh_layer=None, scans=None, faces=None):
         if self.process is None or not self.process.is_alive():
             self.start()
-        self.conn.send((points, normals, params, mesh_layer, scans))
+        self.conn.send((points, normals, params, mesh_layer, scans, faces))
         if not self.conn.poll(CHILD_TIMEOUT):
             self.stop()
             return {"status": "hang", "message": f"no answer within {CHILD_TIMEOUT} s"}
@@ -141,7 +144,8 @@ def run_recipe(worker, recipe, params):
     scans = split_into_scans(recipe, points, normals) if len(points) and recipe.get("scans", 1) > 1 else None
     if scans:
         params = {**params, "merge_visible_layers": True}
-    answer = worker.run(points, normals, params, scans=scans)
+    faces = None if scans else build_faces(recipe, points)
+    answer = worker.run(points, normals, params, scans=scans, faces=faces)
     check_answer(answer, params)
     return answer
 
@@ -158,7 +162,7 @@ def test_random_clouds_and_parameters(worker, recipe, params):
     event(outcome)
     if os.environ.get("IB_FUZZ_LOG"):  # a line per example checked, for long runs
         with open(os.environ["IB_FUZZ_LOG"], "a") as log:
-            log.write(f"{recipe.get('mesh') or '+'.join(recipe['shapes'])} n={recipe['n']} scans={recipe.get('scans', 1)}: {outcome}\n")
+            log.write(f"{recipe.get('mesh') or '+'.join(recipe['shapes'])} n={recipe['n']} scans={recipe.get('scans', 1)} faces={recipe.get('faces', 'none')}: {outcome}\n")
 
 
 # ---------------------------------------------------------------------------------------------
