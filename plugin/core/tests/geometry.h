@@ -101,6 +101,15 @@ inline void Matrices(const CoreMesh& m, Points& V, Faces& F)
             F(Eigen::Index(i), k) = int(vcg::tri::Index(m, m.face[i].cV(k)));
 }
 
+/// The unit square [0, 1]^2 in z = 0 as two triangles, counter-clockwise seen from +z.
+inline void UnitSquare(Points& V, Faces& F)
+{
+    V.resize(4, 3);
+    V << 0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0;
+    F.resize(2, 3);
+    F << 0, 1, 2, 0, 2, 3;
+}
+
 /// An icosphere of radius 1 (VCGlib's, subdivided `levels` times: 4 gives 2562 vertices and
 /// 5120 faces), outward-oriented.
 inline void Icosphere(Points& V, Faces& F, int levels = 4)

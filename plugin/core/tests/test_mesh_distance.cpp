@@ -116,10 +116,9 @@ TEST(MeshDistance, SamplesOnHalfTheSphereGiveOneLoopAtTheRim)
 TEST(MeshDistance, PastBorderIsTheInPlaneDistanceBeyondAnOpenEdge)
 {
     // The unit square of two triangles in z = 0: its four edges are its border.
-    Points V(4, 3);
-    V << 0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0;
-    Faces F(2, 3);
-    F << 0, 1, 2, 0, 2, 3;
+    Points V;
+    Faces F;
+    test::UnitSquare(V, F);
     const MeshDistance square(V, F);
     Points Q(5, 3);
     Q << 0.5, 0.5, 0.8,   // over the inside, high above it

@@ -116,10 +116,9 @@ TEST(MeshHoles, CoveredTellsHoleRegionsOverTheMeshFromThosePastItsBorder)
     // The input: the unit square in z = 0. The extraction: a grid over [0, 1.5] x [0, 1] in
     // z = 0.1 whose faces are all hole faces, region 0 left of x = 0.9 (over the square), region
     // 1 right of x = 1.1 (past its border), region 2 across the border.
-    Points V(4, 3);
-    V << 0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0;
-    Faces F(2, 3);
-    F << 0, 1, 2, 0, 2, 3;
+    Points V;
+    Faces F;
+    test::UnitSquare(V, F);
     const MeshDistance square(V, F);
     CoreMesh all;
     test::Grid(30, 0.05, all);
