@@ -192,6 +192,7 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 	p.rbf.overlap = par.getFloat("rbf_overlap");
 	p.rbf.off_surface = par.getFloat("rbf_off_surface");
 	p.memory_limit = 1e9 * par.getFloat("memory_limit");
+	p.tile = ib_plugin::tileParameters(par);
 
 	std::unique_ptr<ib::MeshDistance> meshImplicit;
 	if (p.implicit == ib::Reconstruction::Implicit::Given) {
@@ -300,6 +301,9 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 	log("Lattice %dx%dx%d, cell %g (resolution %d%s, sample spacing %g).",
 		r.lattice_cells[0], r.lattice_cells[1], r.lattice_cells[2], r.cell_size, r.resolution,
 		r.resolution_automatic ? ", automatic" : "", r.sample_spacing);
+	if (p.tile.Fixed())
+		log("A tile on the fixed lattice of cell %g from (%g, %g, %g): %s.", p.tile.cell, p.tile.origin[0],
+			p.tile.origin[1], p.tile.origin[2], p.tile.block.isEmpty() ? "every face kept" : "kept the faces whose centre lies in its block");
 	if (r.resolution_automatic && r.resolution == ib::Reconstruction::kMaxAutoResolution)
 		log("Warning: the automatic resolution was capped at %d: the longest side of the samples' box is %.0f "
 			"sample spacings, which asks for %d cells; cells are %.2f spacings wide, so detail under a cell "

@@ -36,6 +36,7 @@ public:
 
 private:
 	RichParameterList reconstructionParameters(const MeshDocument& md) const;
+	static void addTileParameters(RichParameterList& par);
 	std::map<std::string, QVariant> reconstructWithBoundaries(
 		MeshDocument& md, const RichParameterList& par, vcg::CallBackPos* cb);
 };

@@ -226,5 +226,61 @@ RichParameterList FilterImplicitBoundariesPlugin::reconstructionParameters(const
 		"Samples used to fit each tangent plane when normals are estimated. Raise it for noisy "
 		"scans, lower it for thin details.",
 		true));
+	addTileParameters(par);
 	return par;
+}
+
+namespace {
+
+Eigen::Vector3d toVector3(const Point3m& p)
+{
+	return Eigen::Vector3d(p[0], p[1], p[2]);
+}
+
+} // namespace
+
+void FilterImplicitBoundariesPlugin::addTileParameters(RichParameterList& par)
+{
+	const QString tiles = "For one tile of a scan reconstructed tile by tile (the Python package's "
+						  "'implicit-boundaries tiled' sets it): ";
+	par.addParam(RichFloat(
+		"lattice_cell", 0, "Tiles: lattice cell (0 = off)",
+		tiles + "the cell of the whole scan's lattice, whose corners lie at the lattice origin plus whole "
+				"cells, so that neighbouring tiles compute the corners they share from the same numbers. "
+				"0: the lattice fits the layer (normal use; leave the tile parameters alone).",
+		true));
+	par.addParam(RichPosition(
+		"lattice_origin", Point3m(0, 0, 0), "Tiles: lattice origin",
+		tiles + "the whole scan's lattice corner (0, 0, 0), below every sample.", true));
+	par.addParam(RichPosition(
+		"lattice_end", Point3m(0, 0, 0), "Tiles: lattice end",
+		tiles + "the whole scan's far lattice corner, above every sample; with the origin it also roots "
+				"the PU-RBF's octree, so each tile fits the cells one run would.",
+		true));
+	par.addParam(RichFloat(
+		"lattice_spacing", 0, "Tiles: sample spacing",
+		tiles + "the whole scan's median sample spacing, which sets the tangent disks' reach and the "
+				"boundary stage's scale. 0: the layer's own.",
+		true));
+	par.addParam(RichPosition(
+		"block_min", Point3m(0, 0, 0), "Tiles: block minimum",
+		tiles + "the low corner of the tile's block: only faces whose centre lies in [block minimum, "
+				"block maximum) are kept. Equal corners: keep every face.",
+		true));
+	par.addParam(RichPosition(
+		"block_max", Point3m(0, 0, 0), "Tiles: block maximum", tiles + "the high corner of the tile's block.",
+		true));
+}
+
+ib::Tile ib_plugin::tileParameters(const RichParameterList& par)
+{
+	ib::Tile t;
+	t.cell = par.getFloat("lattice_cell");
+	t.origin = toVector3(par.getPoint3m("lattice_origin"));
+	t.end = toVector3(par.getPoint3m("lattice_end"));
+	t.spacing = par.getFloat("lattice_spacing");
+	const Eigen::Vector3d lo = toVector3(par.getPoint3m("block_min")), hi = toVector3(par.getPoint3m("block_max"));
+	if (lo != hi)
+		t.block = Eigen::AlignedBox3d(lo, hi);
+	return t;
 }

@@ -30,8 +30,9 @@ inline Index3 UnpackIndex(uint64_t key)
     return Index3(int(key & mask), int((key >> 20) & mask), int(key >> 40));
 }
 
-/// A cubic lattice: `cells` cells per axis of side `cell_size`, starting at `origin`.
-/// Corner (i,j,k) sits at origin + cell_size*(i,j,k); cell (i,j,k) spans corners (i,j,k)..(i+1,j+1,k+1).
+/// A cubic lattice: `cells` cells per axis of side `cell_size`, cut from the grid of corners
+/// origin + cell_size*(i,j,k) from grid index `first` on. Corner (i,j,k) of the lattice sits at
+/// origin + cell_size*(first + (i,j,k)); cell (i,j,k) spans corners (i,j,k)..(i+1,j+1,k+1).
 struct Lattice
 {
     /// Largest number of cells per axis (the packed keys hold 20 bits per axis).
@@ -40,6 +41,10 @@ struct Lattice
     Eigen::Vector3d origin = Eigen::Vector3d::Zero();
     double cell_size = 1;
     Index3 cells = Index3::Zero();
+    /// Grid index of corner (0,0,0): 0 for a lattice fitted to its samples; a tile's lattice
+    /// (tiling.h) is cut from the whole scan's grid, so the corners two tiles share are
+    /// computed from the same numbers.
+    Index3 first = Index3::Zero();
 
     /// Lattice with `resolution` cells along the longest side of [lo, hi], padded by `pad`
     /// cells on every side so that dilated cells and their corners stay inside.
@@ -55,9 +60,24 @@ struct Lattice
         return l;
     }
 
+    /// The cells of the grid of corners origin + cell*(i,j,k) that cover [lo, hi], padded by
+    /// `pad` cells on every side.
+    static Lattice OnGrid(const Eigen::Vector3d& origin, double cell, const Eigen::Vector3d& lo,
+                          const Eigen::Vector3d& hi, int pad)
+    {
+        Lattice l;
+        l.origin = origin;
+        l.cell_size = cell;
+        for (int a = 0; a < 3; ++a) {
+            l.first[a] = int(std::floor((lo[a] - origin[a]) / cell)) - pad;
+            l.cells[a] = int(std::floor((hi[a] - origin[a]) / cell)) + 1 + pad - l.first[a];
+        }
+        return l;
+    }
+
     Eigen::Vector3d Corner(int x, int y, int z) const
     {
-        return origin + cell_size * Eigen::Vector3d(x, y, z);
+        return origin + cell_size * Eigen::Vector3d(first[0] + x, first[1] + y, first[2] + z);
     }
 
     /// Cell holding point p, clamped into the lattice.
@@ -65,7 +85,8 @@ struct Lattice
     {
         Index3 c;
         for (int a = 0; a < 3; ++a)
-            c[a] = std::min(cells[a] - 1, std::max(0, int(std::floor((p[a] - origin[a]) / cell_size))));
+            c[a] = std::min(cells[a] - 1,
+                            std::max(0, int(std::floor((p[a] - origin[a]) / cell_size)) - first[a]));
         return c;
     }
 

@@ -119,6 +119,7 @@ private:
         InputCheck::Samples(input, inputNormals, p.facing, p.scan_sizes);
         InputCheck::FacesOf(input, p.faces);
         p.Check();
+        p.tile.Check(input);
         Result r;
         // Repeated samples (merged scans, exported meshes with seams) would make every
         // neighbourhood collapse to one point and the spacing zero: keep one of each.
@@ -144,22 +145,25 @@ private:
         if (cb) cb(5, "Building the implicit function");
         const std::vector<int> scan = ScanOfSamples(p.scan_sizes, input.rows(), kept);
         const Eigen::VectorXd spacing = SampleSpacing::PerScan(samples, scan, p.threads);
-        r.sample_spacing = SampleSpacing::Median(spacing);
+        r.sample_spacing = p.tile.spacing > 0 ? p.tile.spacing : SampleSpacing::Median(spacing);
         const Eigen::Vector3d lo = P.colwise().minCoeff().transpose(), hi = P.colwise().maxCoeff().transpose();
         const double longest = (hi - lo).maxCoeff();
-        r.resolution_automatic = p.resolution == 0;
+        r.resolution_automatic = p.resolution == 0 && !p.tile.Fixed();
         r.resolution = p.resolution;
         r.resolution_from_spacing =
             int(std::min(1e9, std::round(longest / (kCellPerSpacing * r.sample_spacing))));
         if (r.resolution_automatic)
             r.resolution = std::clamp(r.resolution_from_spacing, kMinResolution, kMaxAutoResolution);
+        if (p.tile.Fixed())
+            r.resolution = std::max(1, int(std::ceil(longest / p.tile.cell)));
         // Padding keeps every SODS cell and its corners inside the lattice: the widest disk
         // (capped at the lattice size: an outlier's disk may be clipped), the dilation, one more.
-        const double cell = longest / r.resolution;
+        const double cell = p.tile.Fixed() ? p.tile.cell : longest / r.resolution;
         const int diskCells = p.sods_occupancy == Occupancy::TangentDisks
                                   ? std::min(r.resolution, int(std::ceil(p.sample_radius * spacing.maxCoeff() / cell)))
                                   : 0;
-        const Lattice lattice = Lattice::Fit(lo, hi, r.resolution, p.sods_dilation + diskCells + 1);
+        const int pad = p.sods_dilation + diskCells + 1;
+        const Lattice lattice = p.tile.Fixed() ? p.tile.Over(lo, hi, pad) : Lattice::Fit(lo, hi, r.resolution, pad);
         r.cell_size = lattice.cell_size;
         r.lattice_cells = lattice.cells;
         r.full_lattice_evaluations = lattice.CornerCount();
@@ -225,8 +229,12 @@ private:
         if (holes)
             BoundaryStage::SplitHoles(surface, inSurface, *holes);
         BoundaryStage::KeepSurface(surface, inSurface);
-        // An empty layer would look like success: say why nothing came out instead.
-        if (surface.face.empty())
+        p.tile.Clip(surface);
+        if (holes)
+            p.tile.Clip(*holes);
+        // An empty layer would look like success: say why nothing came out instead (a tile's
+        // block may hold no surface).
+        if (surface.face.empty() && p.tile.block.isEmpty())
             throw InputError("No surface was extracted at resolution " + std::to_string(r.resolution) +
                              ": the samples are too few or too scattered to outline a surface. Try a lower "
                              "resolution, a larger sample radius or SODS dilation, or more samples.");
@@ -257,6 +265,7 @@ private:
             p.scan_sizes.size() > 1 ? p.rbf.PerSheet(SampleSpacing::Overlap(samples, spacing, p.threads)) : p.rbf;
         rp.threads = p.threads;
         rp.spacing = spacing;
+        rp.root = p.tile.Root();
         try {
             if (p.scan_sizes.size() > 1) {
                 const std::vector<Eigen::Index> fit = ScanEdges::Uncovered(samples, N, scan, spacing, p.threads);

@@ -9,6 +9,7 @@
 #include "implicit/pu_rbf.h"
 #include "input_check.h"
 #include "lattice.h"
+#include "tiling.h"
 
 #include <Eigen/Core>
 
@@ -70,6 +71,9 @@ struct ReconstructionParam
     /// m×3 rows of the input (one scan given as a triangle mesh), or empty (a point cloud):
     /// the holes of the triangulation stay open, as their rims say (mesh_holes.h).
     Faces faces;
+    /// A tile of a scan reconstructed tile by tile (tiling.h): the whole scan's lattice, octree
+    /// root and spacing, and the block whose faces are kept; default: not a tile.
+    Tile tile;
 
     /// Throws InputError when a parameter is out of its range.
     void Check() const
@@ -103,6 +107,8 @@ struct ReconstructionParam
             throw InputError("The minimum number of boundary edges cannot be negative (0 keeps every hole).");
         if (normal_neighbours < 3 || normal_neighbours > 256)
             throw InputError("Normal neighbours must be between 3 and 256.");
+        if (tile.Fixed() && resolution != 0)
+            throw InputError("A fixed lattice sets its own cell size: leave the resolution at 0 with it.");
     }
 };
 

@@ -1,7 +1,8 @@
 """Command line: ``implicit-boundaries`` (or ``python -m implicit_boundaries``).
 
 Subcommands: ``reconstruct IN [IN ...] -o OUT`` (any format pymeshlab reads and writes;
-several scans, or an ``.aln``/``.conf`` alignment, give one merged surface), ``compare IN
+several scans, or an ``.aln``/``.conf`` alignment, give one merged surface), ``tiled IN... -o
+OUT`` (a large scan tile by tile on Dask), ``compare IN
 [--truth GT] --report DIR`` (side by side with MeshLab's screened Poisson), ``demo``
 (pymeshlab's bunny scan with its holes, reconstructed and compared) and ``info`` (versions,
 plugin path, whether it loads). Errors are one line on stderr and exit status 1; ``--verbose``
@@ -121,6 +122,27 @@ def cmd_reconstruct(args) -> int:
     return 0
 
 
+def cmd_tiled(args) -> int:
+    from . import tiled
+    params = _filter_params(args)
+    if "normals" in params:
+        raise ValueError("tiled runs use the scans' own normals (or normals estimated once per file): "
+                         "--estimate-normals and --viewpoint are for one run (reconstruct)")
+    r = tiled.reconstruct([str(path) for path in args.input], resolution=args.resolution or 0, tiles=args.tiles,
+                          tile_cells=args.tile_cells, workers=args.workers, scheduler=args.scheduler,
+                          progress=True, **params)
+    out = Path(args.output)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=r.vertices, face_matrix=r.faces), "tiled")
+    ms.save_current_mesh(str(out))
+    sizes = ", ".join(str(len(loop)) for loop in r.loops) or "none"
+    print(f"\n{r.info['tiles']} tiles (cell {r.info['cell_size']:.4g}), {len(r.faces)} faces")
+    print(f"{len(r.loops)} boundary loops kept; edges per loop: {sizes}")
+    print(f"wrote {out.resolve()}")
+    return 0
+
+
 def _compare(args, input, truth) -> int:
     bar = ProgressBar()
     args.progress = bar  # main() closes it before an error message
@@ -190,6 +212,18 @@ def _parser() -> argparse.ArgumentParser:
     r.add_argument("-o", "--output", required=True)
     options(r)
     r.set_defaults(run=cmd_reconstruct)
+
+    t = sub.add_parser("tiled", help="reconstruct a large scan tile by tile on Dask (local workers or a cluster)")
+    t.add_argument("input", nargs="+", help="point files, with normals (estimated once per file when they have none)")
+    t.add_argument("-o", "--output", required=True)
+    t.add_argument("--tiles", type=int, help="at least this many tiles (default: tiles of --tile-cells cells a side)")
+    t.add_argument("--tile-cells", type=int, default=256, help="lattice cells along a tile's side (default 256)")
+    engine = t.add_mutually_exclusive_group()
+    engine.add_argument("--workers", type=int, help="local Dask worker processes (default: the cores)")
+    engine.add_argument("--scheduler", metavar="ADDRESS",
+                        help="an existing Dask scheduler, e.g. tcp://host:8786 (each worker needs this package)")
+    options(t)
+    t.set_defaults(run=cmd_tiled)
 
     def comparison(q, report):
         q.add_argument("--report", required=report is None, default=report,

@@ -3,7 +3,7 @@
 /// Adaptive octree over a point set, for the partition of unity (pu_rbf.h): its leaves are the
 /// cells, each with a support box around its samples that overlaps the neighbours' boxes.
 ///
-/// The root is the bounding cube of the samples; a node is split into 8 equal octants while it
+/// The root is the bounding cube of the samples (or Param::root); a node is split into 8 equal octants while it
 /// holds more than `max_samples` samples, or while its support box (SupportBox) holds more than
 /// `max_support_samples`, down to depth kMaxDepth (piles of identical samples cannot be split).
 /// Each node owns a contiguous range of Order(), so a subtree's samples are one slice of it.
@@ -24,18 +24,21 @@ namespace ib {
 class PointOctree
 {
 public:
-    struct Param
-    {
-        int max_samples = 160;               ///< a node holding more samples is split (>= 1)
-        double overlap = 1.5;                ///< support box side / leaf side (>= 1)
-        size_t max_support_samples = 1200;   ///< a node whose support box holds more is split
-    };
-
     /// An axis-aligned cube: [centre - half, centre + half] on every axis.
     struct Box
     {
         Eigen::Vector3d centre = Eigen::Vector3d::Zero();
         double half = 0;
+    };
+
+    struct Param
+    {
+        int max_samples = 160;               ///< a node holding more samples is split (>= 1)
+        double overlap = 1.5;                ///< support box side / leaf side (>= 1)
+        size_t max_support_samples = 1200;   ///< a node whose support box holds more is split
+        /// The root's cube; half 0: the samples' bounding cube. A tile of a scan (tiling.h)
+        /// roots its octree at the whole scan's, so its cells are the whole scan's cells.
+        Box root;
     };
 
     struct Node
@@ -179,8 +182,9 @@ private:
             order_[size_t(i)] = int(i);
         const Eigen::Vector3d lo = P.colwise().minCoeff(), hi = P.colwise().maxCoeff();
         Node root;
-        root.centre = 0.5 * (lo + hi);
-        root.half = 0.5 * (hi - lo).maxCoeff() * (1 + 1e-9);
+        const Box& given = param_.root;
+        root.centre = given.half > 0 ? given.centre : Eigen::Vector3d(0.5 * (lo + hi));
+        root.half = given.half > 0 ? given.half : 0.5 * (hi - lo).maxCoeff() * (1 + 1e-9);
         root.end = int(n);
         nodes_.push_back(root);
         std::vector<int> scratch;

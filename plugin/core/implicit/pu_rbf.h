@@ -78,6 +78,7 @@ public:
         /// own scan: overlapping scans multiply the density but lie apart by their registration
         /// error, so off-surface points one merged spacing out land on the next scan's sheet.
         Eigen::VectorXd spacing;
+        PointOctree::Box root;         ///< the octree's root cube (half 0: the samples' bounding cube)
 
         /// Fits of 20-60 samples per cell instead of the paper's 50-160, whose smoother fits cut
         /// across concave creases and thin parts, away from the samples (BENCHMARKS.md, "Smaller
@@ -145,9 +146,7 @@ public:
     {
     }
 
-    /// With the default Param.
-    PuRbf(const Points& P, const Points& N) : PuRbf(P, N, Param()) {}
-
+    PuRbf(const Points& P, const Points& N) : PuRbf(P, N, Param()) {}  ///< with the default Param
     PuRbf(const PuRbf&) = delete;  // index_ and octree_ refer to P_
     PuRbf& operator=(const PuRbf&) = delete;
 
@@ -190,6 +189,7 @@ private:
         octree.max_samples = param.max_samples;
         octree.overlap = param.overlap;
         octree.max_support_samples = kSplitFactor * size_t(param.max_fit_samples);
+        octree.root = param.root;
         octree_ = PointOctree(P_, octree);
         std::vector<PointOctree::Box> boxes = LeafBoxes();
         progress(5, "PU-RBF: off-surface points");

@@ -56,3 +56,33 @@ TEST(Lattice, PackedKeysRoundTripAndSortByZYX)
     EXPECT_LT(PackIndex(5, 3, 2), PackIndex(6, 3, 2));
     EXPECT_EQ(PackIndex(top, top, top) >> 60, 0u);  // 4 bits left for edge keys
 }
+
+TEST(Lattice, LatticesOnOneGridShareTheirCornersBitForBit)
+{
+    // Two overlapping boxes on one grid (two tiles of a scan): each covers its box, with the
+    // padding, and a grid corner both hold has the same coordinates, to the last bit, in both.
+    const Eigen::Vector3d origin(-1.3, 0.7, 2.1);
+    const double cell = 0.0371;
+    const Lattice a = Lattice::OnGrid(origin, cell, Eigen::Vector3d(-1, 1, 2.5), Eigen::Vector3d(0.2, 1.4, 2.9), 2);
+    const Lattice b = Lattice::OnGrid(origin, cell, Eigen::Vector3d(-0.1, 0.9, 2.6), Eigen::Vector3d(0.8, 1.9, 3.3), 2);
+    for (const Lattice* l : {&a, &b}) {
+        EXPECT_TRUE((l->Corner(2, 2, 2).array() <= Eigen::Array3d(l == &a ? -1 : -0.1, l == &a ? 1 : 0.9, l == &a ? 2.5 : 2.6)).all());
+        EXPECT_EQ(l->CellOf(l->Corner(3, 4, 5) + Eigen::Vector3d::Constant(0.5 * cell)), Index3(3, 4, 5));
+    }
+    EXPECT_TRUE((a.Corner(a.cells[0] - 2, a.cells[1] - 2, a.cells[2] - 2).array() >= Eigen::Array3d(0.2, 1.4, 2.9)).all());
+    int shared = 0;
+    for (int z = 0; z <= a.cells[2]; ++z)
+        for (int y = 0; y <= a.cells[1]; ++y)
+            for (int x = 0; x <= a.cells[0]; ++x) {
+                const Index3 g = a.first + Index3(x, y, z), inB = g - b.first;
+                if ((inB.array() < 0).any() || (inB.array() > b.cells.array()).any())
+                    continue;
+                const Eigen::Vector3d pa = a.Corner(x, y, z), pb = b.Corner(inB[0], inB[1], inB[2]);
+                ASSERT_TRUE(pa == pb) << "grid corner " << g.transpose();
+                ++shared;
+            }
+    EXPECT_GT(shared, 1000);
+    // A lattice fitted to its samples is the grid from its own origin on.
+    const Lattice fit = Lattice::Fit(Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 2, 3), 10, 1);
+    EXPECT_EQ(fit.first, Index3::Zero());
+}
