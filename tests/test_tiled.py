@@ -5,6 +5,7 @@ import pytest
 
 from implicit_boundaries import reconstruct, tiled
 from implicit_boundaries.metrics import boundary_edges, point_mesh_distance
+from implicit_boundaries.tile_join import Join, border_half_edges, trace_loops
 
 from shapes import wavy_cap
 
@@ -97,10 +98,46 @@ def test_the_command_line_writes_the_tiled_surface(plugin, tmp_path, capsys):
     assert "2 tiles" in printed and "1 boundary loops kept" in printed
     ms.load_new_mesh(str(out))
     assert ms.current_mesh().face_number() > 20_000
-    assert len(tiled.boundary_loops(ms.current_mesh().face_matrix())) == 1
+    assert len(trace_loops(border_half_edges(ms.current_mesh().face_matrix()))) == 1
 
 
 def test_the_command_line_refuses_estimated_normals(tmp_path, capsys):
     from implicit_boundaries.cli import main
     assert main(["tiled", str(tmp_path / "any.ply"), "-o", str(tmp_path / "o.ply"), "--estimate-normals"]) == 1
     assert "use the scans' own normals" in capsys.readouterr().err
+
+
+def _grid(n):
+    """A flat n x n grid of unit squares, two triangles each: (vertices, faces)."""
+    i, j = np.meshgrid(np.arange(n + 1), np.arange(n + 1), indexing="ij")
+    vertices = np.column_stack([i.ravel(), j.ravel(), np.zeros(i.size)]).astype(np.float64)
+    at = lambda a, b: a * (n + 1) + b
+    faces = []
+    for a in range(n):
+        for b in range(n):
+            faces += [(at(a, b), at(a + 1, b), at(a + 1, b + 1)), (at(a, b), at(a + 1, b + 1), at(a, b + 1))]
+    return vertices, np.array(faces, dtype=np.int32)
+
+
+def test_the_join_welds_pieces_at_their_seam_and_streams_them(tmp_path):
+    # A 10 x 10 grid cut into two pieces at x = 4.5 (face centres), one piece's seam vertices off
+    # by 1e-12: joined, the grid's 121 vertices and 200 faces, and its one 40-edge border, in
+    # memory and in the PLY file.
+    vertices, faces = _grid(10)
+    centre_x = vertices[faces].mean(axis=1)[:, 0]
+    join = Join(1e-6)
+    for keep, shift in ((centre_x < 4.5, 0.0), (centre_x >= 4.5, 1e-12)):
+        used, local = np.unique(faces[keep], return_inverse=True)
+        join.add(vertices[used] + shift, local.reshape(-1, 3))
+    loops = join.finish()
+    V, F = join.arrays()
+    assert (len(V), len(F)) == (121, 200)
+    assert [len(loop) for loop in loops] == [40]
+    out = tmp_path / "joined.ply"
+    join.write_ply(out)
+    join.close()
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(str(out))
+    assert (ms.current_mesh().vertex_number(), ms.current_mesh().face_number()) == (121, 200)
+    np.testing.assert_array_equal(ms.current_mesh().face_matrix(), F)
+    assert len(trace_loops(border_half_edges(F))) == 1

@@ -128,16 +128,15 @@ def cmd_tiled(args) -> int:
     if "normals" in params:
         raise ValueError("tiled runs use the scans' own normals (or normals estimated once per file): "
                          "--estimate-normals and --viewpoint are for one run (reconstruct)")
+    out = Path(args.output)
+    if out.suffix.lower() != ".ply":
+        raise ValueError(f"{out}: tiled runs write binary PLY, streamed tile by tile: name the output .ply")
+    out.parent.mkdir(parents=True, exist_ok=True)
     r = tiled.reconstruct([str(path) for path in args.input], resolution=args.resolution or 0, tiles=args.tiles,
                           tile_cells=args.tile_cells, workers=args.workers, scheduler=args.scheduler,
-                          progress=True, **params)
-    out = Path(args.output)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    ms = pymeshlab.MeshSet()
-    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=r.vertices, face_matrix=r.faces), "tiled")
-    ms.save_current_mesh(str(out))
+                          progress=True, output=str(out), **params)
     sizes = ", ".join(str(len(loop)) for loop in r.loops) or "none"
-    print(f"\n{r.info['tiles']} tiles (cell {r.info['cell_size']:.4g}), {len(r.faces)} faces")
+    print(f"\n{r.info['tiles']} tiles (cell {r.info['cell_size']:.4g}), {r.info['face_count']} faces")
     print(f"{len(r.loops)} boundary loops kept; edges per loop: {sizes}")
     print(f"wrote {out.resolve()}")
     return 0

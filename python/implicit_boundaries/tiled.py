@@ -6,18 +6,17 @@ in the worker's process on the block's samples plus a halo, on the whole scan's 
 the PU-RBF's octree rooted at the whole scan's cube, and keeps the faces whose centre lies in
 the block. Values at the lattice corners a block shares with its neighbour are then computed
 from the same samples and the same numbers, so the faces of neighbouring blocks meet at the
-same vertices; the join welds them.
+same vertices; the join (tile_join.py) welds them, one piece in memory at a time.
 """
 import os
 from dataclasses import dataclass
-from typing import Dict, Iterator, List, Optional, Sequence, Tuple, Union
+from typing import Dict, Iterator, Optional, Sequence, Tuple, Union
 
 import numpy as np
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
 from .reconstruct import Reconstruction
+from .tile_join import Join
 
 #: The filter's automatic cell in sample spacings (Reconstruction::kCellPerSpacing).
 CELL_PER_SPACING = 0.6
@@ -107,63 +106,27 @@ def _reconstruct_tile(points: np.ndarray, normals: np.ndarray, params: Dict[str,
     """One task: the tile's faces (vertices, faces, the filter's result dictionary)."""
     from .reconstruct import reconstruct as run
     r = run(points, normals, **params)
+    r.info["worker_peak_bytes"] = _peak_resident_bytes()
     return r.vertices, r.faces, r.info
+
+
+def _peak_resident_bytes() -> float:
+    """This process's peak resident memory so far (Linux's VmHWM; getrusage's ru_maxrss would
+    carry the peak of the process that forked the worker), 0 where /proc is not there."""
+    try:
+        with open("/proc/self/status") as status:
+            for line in status:
+                if line.startswith("VmHWM:"):
+                    return 1024.0 * int(line.split()[1])
+    except OSError:
+        pass
+    return 0.0
 
 
 def _tile_rows(points: np.ndarray, lo: np.ndarray, hi: np.ndarray, halo: float) -> np.ndarray:
     """Rows (ascending, as one run sees them) of the samples in [lo - halo, hi + halo]."""
     inside = np.all((points >= lo - halo) & (points <= hi + halo), axis=1)
     return np.flatnonzero(inside)
-
-
-def weld(vertices: np.ndarray, faces: np.ndarray, tolerance: float) -> Tuple[np.ndarray, np.ndarray]:
-    """Merges vertices at the same position (and border vertices within `tolerance` of each
-    other: two tiles' seam vertices that differ in their last bits), drops faces left with a
-    repeated vertex. Returns the compacted (vertices, faces)."""
-    unique, inverse = np.unique(vertices, axis=0, return_inverse=True)
-    faces = inverse.reshape(-1)[faces]
-    edges = np.sort(np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]), axis=1)
-    e, counts = np.unique(edges, axis=0, return_counts=True)
-    border = np.unique(e[counts == 1])
-    if len(border) > 1 and tolerance > 0:
-        pairs = cKDTree(unique[border]).query_pairs(tolerance, output_type="ndarray")
-        if len(pairs):
-            graph = coo_matrix((np.ones(len(pairs)), (border[pairs[:, 0]], border[pairs[:, 1]])),
-                               shape=(len(unique), len(unique)))
-            _, label = connected_components(graph, directed=False)
-            _, first = np.unique(label, return_index=True)
-            faces = first[label][faces]
-    faces = faces[(faces[:, 0] != faces[:, 1]) & (faces[:, 1] != faces[:, 2]) & (faces[:, 2] != faces[:, 0])]
-    used, compact = np.unique(faces, return_inverse=True)
-    return unique[used], compact.reshape(-1, 3).astype(np.int32)
-
-
-def boundary_loops(faces: np.ndarray) -> List[np.ndarray]:
-    """The boundary loops of an oriented triangle mesh, largest first: each the cycle of vertex
-    indices along its border half-edges (a pinch vertex, where two loops touch, starts a new
-    cycle at its second visit)."""
-    faces = np.asarray(faces, dtype=np.int64)
-    half = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
-    key = half[:, 0] * (faces.max() + 1) + half[:, 1]
-    twin = half[:, 1] * (faces.max() + 1) + half[:, 0]
-    border = half[~np.isin(key, twin)]
-    successors: Dict[int, List[int]] = {}
-    for a, b in border.tolist():
-        successors.setdefault(a, []).append(b)
-    loops = []
-    while successors:
-        start = next(iter(successors))
-        loop, v = [start], successors[start].pop()
-        if not successors[start]:
-            del successors[start]
-        while v != start:
-            loop.append(v)
-            nxt = successors[v].pop()
-            if not successors[v]:
-                del successors[v]
-            v = nxt
-        loops.append(np.array(loop, dtype=np.int64))
-    return sorted(loops, key=len, reverse=True)
 
 
 def _client(workers: Optional[int], scheduler: Optional[str]):
@@ -184,7 +147,7 @@ def _client(workers: Optional[int], scheduler: Optional[str]):
 def reconstruct(points_or_files: Union[np.ndarray, str, Sequence[str]], normals: Optional[np.ndarray] = None, *,
                 resolution: int = 0, tiles: Optional[int] = None, tile_cells: int = 256,
                 workers: Optional[int] = None, scheduler: Optional[str] = None, progress: bool = False,
-                **filter_params) -> Reconstruction:
+                output: Optional[str] = None, **filter_params) -> Reconstruction:
     """The surface with boundaries of a scan, reconstructed in tiles on Dask.
 
     points_or_files: (n, 3) samples, or one or more point files (read with their normals);
@@ -194,49 +157,54 @@ def reconstruct(points_or_files: Union[np.ndarray, str, Sequence[str]], normals:
     many blocks, else blocks of about `tile_cells` cells a side; workers: local worker
     processes (default: the cores); scheduler: the address of an existing Dask scheduler
     instead (every worker needs this package and pymeshlab); progress: Dask's progress bar;
+    output: a .ply path: the surface is streamed there piece by piece and the returned
+    Reconstruction holds no vertices or faces (its loops index the file's vertices);
     filter_params: the filter's other parameters by their pymeshlab names.
     Returns a Reconstruction whose info holds the plan and per-tile figures.
     """
     points, normals = _samples(points_or_files, normals)
     p = plan(points, resolution=resolution, tiles=tiles, tile_cells=tile_cells)
     client, cluster = _client(workers, scheduler)
+    join = Join(1e-6 * p.cell)
     try:
-        futures, blocks = [], []
+        from distributed import as_completed
+        futures, blocks = [], {}
         for index, lo, hi in p.blocks():
             rows = _tile_rows(points, lo, hi, p.halo)
             if len(rows) < 20:  # the filter needs samples to fit planes; such a block holds no surface
                 continue
             params = dict(filter_params, **p.filter_params(lo, hi))
-            futures.append(client.submit(_reconstruct_tile, points[rows], normals[rows], params, pure=False))
-            blocks.append((index, len(rows)))
+            future = client.submit(_reconstruct_tile, points[rows], normals[rows], params, pure=False)
+            futures.append(future)
+            blocks[future.key] = (index, len(rows))
         if progress:
             from distributed import progress as show
             show(futures)
-        results = client.gather(futures)
+        tile_info = []
+        for future in as_completed(futures):  # each piece to disk as it comes: the client holds one
+            vertices, faces, info = future.result()
+            join.add(vertices, faces)
+            tile_info.append(dict(block=blocks[future.key][0], samples=blocks[future.key][1],
+                                  faces=len(faces), seconds=sum(v for k, v in info.items() if k.startswith("seconds_")),
+                                  worker_peak_bytes=info["worker_peak_bytes"]))
+            future.release()
+        loops = join.finish()
+        if output is None:
+            vertices, faces = join.arrays()
+        else:
+            join.write_ply(output)
+            vertices, faces = np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int32)
+        info = dict(tiles=len(tile_info), vertex_count=join.vertex_count, face_count=join.face_count,
+                    cell_size=p.cell, sample_spacing=p.spacing, lattice_origin=p.origin.tolist(),
+                    lattice_end=p.end.tolist(), halo=p.halo, boundary_loops=len(loops),
+                    boundary_loop_edges=[len(loop) for loop in loops], tile_info=tile_info,
+                    worker_peak_bytes=max((t["worker_peak_bytes"] for t in tile_info), default=0.0))
+        return Reconstruction(vertices, faces, loops, info)
     finally:
+        join.close()
         client.close()
         if cluster is not None:
             cluster.close()
-    return _join(results, blocks, p)
-
-
-def _join(results, blocks, p: Plan) -> Reconstruction:
-    """The tiles' faces as one welded mesh with its loops."""
-    vertices, faces, offset = [], [], 0
-    for v, f, _ in results:
-        vertices.append(v)
-        faces.append(f.astype(np.int64) + offset)
-        offset += len(v)
-    V = np.concatenate(vertices) if vertices else np.zeros((0, 3))
-    F = np.concatenate(faces) if faces else np.zeros((0, 3), dtype=np.int64)
-    V, F = weld(V, F, 1e-6 * p.cell)
-    loops = boundary_loops(F) if len(F) else []
-    info = dict(tiles=len(blocks), blocks=[b for b, _ in blocks], tile_samples=[n for _, n in blocks],
-                cell_size=p.cell, sample_spacing=p.spacing, lattice_origin=p.origin.tolist(),
-                lattice_end=p.end.tolist(), halo=p.halo, boundary_loops=len(loops),
-                boundary_loop_edges=[len(l) for l in loops],
-                seconds_tiles=[sum(v for k, v in r[2].items() if k.startswith("seconds_")) for r in results])
-    return Reconstruction(V, F.astype(np.int32), loops, info)
 
 
 def _samples(points_or_files, normals) -> Tuple[np.ndarray, np.ndarray]:

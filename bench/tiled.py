@@ -1,0 +1,68 @@
+"""Tiled reconstruction on Dask against one run on the same lattice (issue: tiles on Dask).
+Random samples of a smooth open surface with one boundary (tests/shapes.py `wavy_cap`), at
+each size: one run of the filter on the tiled run's lattice (all faces kept), then the tiled
+run (`implicit_boundaries.tiled`, a local cluster of --workers processes). Printed per size:
+loops and faces of both, how far the tiled surface's vertices lie from the one run's surface
+(in cells; on up to 200,000 of them), the times and their ratio, each worker's peak memory.
+
+    python bench/tiled.py [--sizes 1000000 5000000] [--tiles 8] [--workers 2] [--resolution 1024]
+"""
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from implicit_boundaries import reconstruct, tiled
+from implicit_boundaries.metrics import point_mesh_distance
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
+import shapes  # noqa: E402
+
+
+def peak_kib():
+    """VmHWM of this process (KiB): the one run's peak, with the samples."""
+    for line in Path("/proc/self/status").read_text().splitlines():
+        if line.startswith("VmHWM:"):
+            return int(line.split()[1])
+    return 0
+
+
+def main(argv=None):
+    a = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    a.add_argument("--sizes", type=int, nargs="+", default=[1_000_000, 5_000_000])
+    a.add_argument("--tiles", type=int, default=8)
+    a.add_argument("--workers", type=int, default=2)
+    a.add_argument("--resolution", type=int, default=1024,
+                   help="cells along the longest side (0: 0.6 spacings, uncapped); 1024 = one run's automatic cap")
+    a.add_argument("--skip-single", action="store_true", help="only the tiled run (sizes one machine cannot run)")
+    args = a.parse_args(argv)
+    print("| samples | tiles | cell | one run: loops, faces, s, peak GB | tiled: loops, faces, s, peak GB per worker "
+          "| farthest vertex (cells) | tiled / one run time |")
+    print("|---|---|---|---|---|---|---|")
+    for n in args.sizes:
+        points, normals = shapes.wavy_cap(n, seed=0)
+        p = tiled.plan(points, resolution=args.resolution, tiles=args.tiles)
+        one_cell, far, ratio = "-", "-", "-"
+        if not args.skip_single:
+            Path("/proc/self/clear_refs").write_text("5")  # resets VmHWM
+            start = time.perf_counter()
+            one = reconstruct(points, normals, **p.filter_params(p.origin, p.origin))
+            one_seconds = time.perf_counter() - start
+            one_cell = f"{len(one.loops)}, {len(one.faces):,}, {one_seconds:.1f}, {peak_kib() / 2**20:.2f}"
+        start = time.perf_counter()
+        t = tiled.reconstruct(points, normals, resolution=args.resolution, tiles=args.tiles, workers=args.workers)
+        tiled_seconds = time.perf_counter() - start
+        if not args.skip_single:
+            rng = np.random.default_rng(0)
+            probe = t.vertices[rng.choice(len(t.vertices), min(200_000, len(t.vertices)), replace=False)]
+            far = f"{point_mesh_distance(probe, one.vertices, one.faces).max() / p.cell:.2g}"
+            ratio = f"{tiled_seconds / one_seconds:.2f}"
+            del one
+        print(f"| {n:,} | {t.info['tiles']} | {p.cell:.3g} | {one_cell} | {len(t.loops)}, {len(t.faces):,}, "
+              f"{tiled_seconds:.1f}, {t.info['worker_peak_bytes'] / 2**30:.2f} | {far} | {ratio} |", flush=True)
+
+
+if __name__ == "__main__":
+    main()
