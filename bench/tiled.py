@@ -5,7 +5,8 @@ run (`implicit_boundaries.tiled`, a local cluster of --workers processes). Print
 loops and faces of both, how far the tiled surface's vertices lie from the one run's surface
 (in cells; on up to 200,000 of them), the times and their ratio, each worker's peak memory.
 
-    python bench/tiled.py [--sizes 1000000 5000000] [--tiles 8] [--workers 2] [--resolution 1024]
+    python bench/tiled.py [--sizes 1000000 5000000] [--tiles 8] [--workers 1 2] [--resolution 1024]
+    python bench/tiled.py --sizes 1000000 2000000 4000000 --tiles 0 --tile-cells 512 --resolution 0 --skip-single
 """
 import argparse
 import sys
@@ -32,37 +33,42 @@ def peak_kib():
 def main(argv=None):
     a = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     a.add_argument("--sizes", type=int, nargs="+", default=[1_000_000, 5_000_000])
-    a.add_argument("--tiles", type=int, default=8)
-    a.add_argument("--workers", type=int, default=2)
+    a.add_argument("--tiles", type=int, default=8, help="at least this many tiles (0: tiles of --tile-cells)")
+    a.add_argument("--workers", type=int, nargs="+", default=[2], help="local worker counts to run (scaling)")
+    a.add_argument("--tile-cells", type=int, default=256, help="without --tiles: cells along a tile's side")
     a.add_argument("--resolution", type=int, default=1024,
                    help="cells along the longest side (0: 0.6 spacings, uncapped); 1024 = one run's automatic cap")
     a.add_argument("--skip-single", action="store_true", help="only the tiled run (sizes one machine cannot run)")
     args = a.parse_args(argv)
-    print("| samples | tiles | cell | one run: loops, faces, s, peak GB | tiled: loops, faces, s, peak GB per worker "
+    print("| samples | workers | tiles | cell | one run: loops, faces, s, peak GB | tiled: loops, faces, s, peak GB per worker "
           "| farthest vertex (cells) | tiled / one run time |")
-    print("|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|")
     for n in args.sizes:
         points, normals = shapes.wavy_cap(n, seed=0)
-        p = tiled.plan(points, resolution=args.resolution, tiles=args.tiles)
-        one_cell, far, ratio = "-", "-", "-"
+        tiles = args.tiles or None
+        p = tiled.plan(points, resolution=args.resolution, tiles=tiles, tile_cells=args.tile_cells)
+        one_cell, one = "-", None
         if not args.skip_single:
             Path("/proc/self/clear_refs").write_text("5")  # resets VmHWM
             start = time.perf_counter()
             one = reconstruct(points, normals, **p.filter_params(p.origin, p.origin))
             one_seconds = time.perf_counter() - start
             one_cell = f"{len(one.loops)}, {len(one.faces):,}, {one_seconds:.1f}, {peak_kib() / 2**20:.2f}"
-        start = time.perf_counter()
-        t = tiled.reconstruct(points, normals, resolution=args.resolution, tiles=args.tiles, workers=args.workers)
-        tiled_seconds = time.perf_counter() - start
-        if not args.skip_single:
-            rng = np.random.default_rng(0)
-            probe = t.vertices[rng.choice(len(t.vertices), min(200_000, len(t.vertices)), replace=False)]
-            far = f"{point_mesh_distance(probe, one.vertices, one.faces).max() / p.cell:.2g}"
-            ratio = f"{tiled_seconds / one_seconds:.2f}"
-            del one
-        print(f"| {n:,} | {t.info['tiles']} | {p.cell:.3g} | {one_cell} | {len(t.loops)}, {len(t.faces):,}, "
-              f"{tiled_seconds:.1f}, {t.info['worker_peak_bytes'] / 2**30:.2f} | {far} | {ratio} |", flush=True)
-
+        for workers in args.workers:
+            start = time.perf_counter()
+            t = tiled.reconstruct(points, normals, resolution=args.resolution, tiles=tiles,
+                                  tile_cells=args.tile_cells, workers=workers)
+            tiled_seconds = time.perf_counter() - start
+            far, ratio = "-", "-"
+            if one is not None:
+                rng = np.random.default_rng(0)
+                probe = t.vertices[rng.choice(len(t.vertices), min(200_000, len(t.vertices)), replace=False)]
+                far = f"{point_mesh_distance(probe, one.vertices, one.faces).max() / p.cell:.2g}"
+                ratio = f"{tiled_seconds / one_seconds:.2f}"
+            print(f"| {n:,} | {workers} | {t.info['tiles']} | {p.cell:.3g} | {one_cell} | {len(t.loops)}, "
+                  f"{len(t.faces):,}, {tiled_seconds:.1f}, {t.info['worker_peak_bytes'] / 2**30:.2f} | {far} | {ratio} |",
+                  flush=True)
+            del t
 
 if __name__ == "__main__":
     main()

@@ -7,7 +7,7 @@ from implicit_boundaries import reconstruct, tiled
 from implicit_boundaries.metrics import boundary_edges, point_mesh_distance
 from implicit_boundaries.tile_join import Join, border_half_edges, trace_loops
 
-from shapes import wavy_cap
+from shapes import terrain_with_pond, wavy_cap
 
 
 @pytest.fixture(scope="module")
@@ -104,7 +104,7 @@ def test_the_command_line_writes_the_tiled_surface(plugin, tmp_path, capsys):
 def test_the_command_line_refuses_estimated_normals(tmp_path, capsys):
     from implicit_boundaries.cli import main
     assert main(["tiled", str(tmp_path / "any.ply"), "-o", str(tmp_path / "o.ply"), "--estimate-normals"]) == 1
-    assert "use the scans' own normals" in capsys.readouterr().err
+    assert "oriented by propagation" in capsys.readouterr().err
 
 
 def _grid(n):
@@ -141,3 +141,25 @@ def test_the_join_welds_pieces_at_their_seam_and_streams_them(tmp_path):
     assert (ms.current_mesh().vertex_number(), ms.current_mesh().face_number()) == (121, 200)
     np.testing.assert_array_equal(ms.current_mesh().face_matrix(), F)
     assert len(trace_loops(border_half_edges(F))) == 1
+
+
+def test_a_lidar_file_without_normals_is_tiled_with_normals_facing_the_sensor(plugin, tmp_path, capsys):
+    # A LAS file of a terrain with a pond (no normals stored), in 4 tiles, normals estimated by
+    # each tile facing a viewpoint high above: the terrain's border and the pond's, as one
+    # run with the same viewpoint gives.
+    import laspy
+    from implicit_boundaries.cli import main
+    points, _ = terrain_with_pond(spacing=0.005, noise=0.0)
+    header = laspy.LasHeader(point_format=3, version="1.2")
+    header.scales = np.full(3, 1e-6)
+    header.offsets = points.min(axis=0)
+    las = laspy.LasData(header)
+    las.x, las.y, las.z = points[:, 0], points[:, 1], points[:, 2]
+    scan = tmp_path / "terrain.las"
+    las.write(str(scan))
+    out = tmp_path / "terrain.ply"
+    assert main(["tiled", str(scan), "-o", str(out), "--tiles", "4", "--workers", "2",
+                 "--viewpoint", "0.5", "0.5", "10"]) == 0
+    assert "2 boundary loops kept" in capsys.readouterr().out
+    one = reconstruct(points, viewpoint=np.array([0.5, 0.5, 10.0]))
+    assert len(one.loops) == 2

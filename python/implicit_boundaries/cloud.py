@@ -1,5 +1,6 @@
 """The input point cloud: reading it from a file (the one loader of the command line, the
-comparison, the tests and the benchmarks), and handing it to pymeshlab as a layer."""
+comparison, the tests and the benchmarks; what pymeshlab reads, and LAS/LAZ through laspy),
+and handing it to pymeshlab as a layer."""
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Optional, Tuple, Union
@@ -38,11 +39,36 @@ def mesh_arrays(mesh: pymeshlab.Mesh) -> Tuple[np.ndarray, np.ndarray]:
     return mesh.vertex_matrix().copy(), mesh.face_matrix().copy()
 
 
+#: Extra dimensions of a LAS/LAZ file read as normals (names compared in lower case).
+LAS_NORMALS = (("nx", "ny", "nz"), ("normalx", "normaly", "normalz"), ("normal_x", "normal_y", "normal_z"))
+
+
+def read_las(path: Union[str, Path]) -> Tuple[np.ndarray, Optional[np.ndarray]]:
+    """(points (n, 3), normals (n, 3) or None) of a LAS or LAZ file (LiDAR) through laspy: the
+    scaled x, y, z, and the normals when the file carries them as extra dimensions (nx, ny, nz
+    or normal_x, ...). The coordinates are taken as they are (no reprojection)."""
+    import laspy
+    las = laspy.read(str(path))
+    points = np.column_stack([np.asarray(las.x), np.asarray(las.y), np.asarray(las.z)]).astype(np.float64)
+    names = {name.lower(): name for name in las.point_format.extra_dimension_names}
+    for triple in LAS_NORMALS:
+        if all(n in names for n in triple):
+            return points, np.column_stack([np.asarray(las[names[n]], dtype=np.float64) for n in triple])
+    return points, None
+
+
 def _load(path: Path) -> pymeshlab.MeshSet:
     if not path.is_file():
         raise FileNotFoundError(f"{path}: no such file")
     ms = pymeshlab.MeshSet()
-    ms.load_new_mesh(str(path))
+    if path.suffix.lower() in (".las", ".laz"):
+        points, normals = read_las(path)
+        arrays = dict(vertex_matrix=points)
+        if normals is not None:
+            arrays["v_normals_matrix"] = normals
+        ms.add_mesh(pymeshlab.Mesh(**arrays), path.stem)
+    else:
+        ms.load_new_mesh(str(path))
     return ms
 
 

@@ -15,6 +15,7 @@ from typing import Dict, Iterator, Optional, Sequence, Tuple, Union
 import numpy as np
 from scipy.spatial import cKDTree
 
+from .options import Normals
 from .reconstruct import Reconstruction
 from .tile_join import Join
 
@@ -162,7 +163,8 @@ def reconstruct(points_or_files: Union[np.ndarray, str, Sequence[str]], normals:
     filter_params: the filter's other parameters by their pymeshlab names.
     Returns a Reconstruction whose info holds the plan and per-tile figures.
     """
-    points, normals = _samples(points_or_files, normals)
+    facing = filter_params.get("normals") == Normals.FACING_VIEWPOINT
+    points, normals = _samples(points_or_files, normals, facing)
     p = plan(points, resolution=resolution, tiles=tiles, tile_cells=tile_cells)
     client, cluster = _client(workers, scheduler)
     join = Join(1e-6 * p.cell)
@@ -207,22 +209,28 @@ def reconstruct(points_or_files: Union[np.ndarray, str, Sequence[str]], normals:
             cluster.close()
 
 
-def _samples(points_or_files, normals) -> Tuple[np.ndarray, np.ndarray]:
-    """(n, 3) points and normals from arrays or files; normals are required."""
+def _samples(points_or_files, normals, facing: bool) -> Tuple[np.ndarray, np.ndarray]:
+    """(n, 3) points and normals from arrays or files. Normals are required, unless they are
+    estimated facing a viewpoint (`facing`): each tile then turns its estimates to face it, a
+    rule that needs no other tile (zero normals are returned for the filter to fill)."""
     if isinstance(points_or_files, (str, os.PathLike)) or (
             isinstance(points_or_files, (list, tuple)) and points_or_files and
             isinstance(points_or_files[0], (str, os.PathLike))):
         from .cloud import read_cloud
         files = [points_or_files] if isinstance(points_or_files, (str, os.PathLike)) else list(points_or_files)
-        clouds = [read_cloud(f) for f in files]  # normals estimated once per file when it has none
+        # Without normals: MeshLab's point-cloud normals, once per file (or none, when facing).
+        clouds = [read_cloud(f, estimate_normals=not facing) for f in files]
         points = np.concatenate([c.points for c in clouds])
         normals = np.concatenate([c.normals for c in clouds])
     else:
         points = np.ascontiguousarray(points_or_files, dtype=np.float64).reshape(-1, 3)
+    if normals is None and facing:
+        normals = np.zeros_like(points)
     if normals is None:
-        raise ValueError("tiled reconstruction needs the samples' normals: estimated tile by tile their "
-                         "orientations would not agree across tiles. Estimate them once for the whole scan "
-                         "(e.g. MeshLab's 'Compute normals for point sets') or reconstruct in one run.")
+        raise ValueError("tiled reconstruction needs the samples' normals: estimated tile by tile and oriented "
+                         "by propagation, their orientations would not agree across tiles. Give the normals, "
+                         "or a viewpoint they face (normals=Normals.FACING_VIEWPOINT, viewpoint=...; the CLI's "
+                         "--viewpoint), or reconstruct in one run.")
     normals = np.ascontiguousarray(normals, dtype=np.float64).reshape(-1, 3)
     if normals.shape != points.shape:
         raise ValueError(f"normals have shape {normals.shape}, points {points.shape}: one normal per point")
