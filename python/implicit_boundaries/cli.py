@@ -125,7 +125,7 @@ def cmd_reconstruct(args) -> int:
 def cmd_tiled(args) -> int:
     from . import tiled
     params = _filter_params(args)
-    if params.get("normals") == Normals.ESTIMATE:
+    if params.pop("normals", None) == Normals.ESTIMATE:
         raise ValueError("tiled runs use the scans' own normals, or normals estimated facing --viewpoint: "
                          "oriented by propagation (--estimate-normals), tiles would not agree")
     out = Path(args.output)
@@ -213,8 +213,8 @@ def _parser() -> argparse.ArgumentParser:
     r.set_defaults(run=cmd_reconstruct)
 
     t = sub.add_parser("tiled", help="reconstruct a large scan tile by tile on Dask (local workers or a cluster)")
-    t.add_argument("input", nargs="+", help="point files (any pymeshlab reads, .las, .laz), with normals (estimated "
-                                            "once per file when they have none), or --viewpoint for them to face")
+    t.add_argument("input", nargs="+", help="point files with normals (binary .ply and .las/.laz read in chunks; "
+                                            "any other format pymeshlab reads), or --viewpoint for normals to face")
     t.add_argument("-o", "--output", required=True)
     t.add_argument("--tiles", type=int, help="at least this many tiles (default: tiles of --tile-cells cells a side)")
     t.add_argument("--tile-cells", type=int, default=256, help="lattice cells along a tile's side (default 256)")

@@ -13,10 +13,9 @@ from dataclasses import dataclass
 from typing import Dict, Iterator, Optional, Sequence, Tuple, Union
 
 import numpy as np
-from scipy.spatial import cKDTree
 
-from .options import Normals
 from .reconstruct import Reconstruction
+from .tile_input import Bins, chunks, survey
 from .tile_join import Join
 
 #: The filter's automatic cell in sample spacings (Reconstruction::kCellPerSpacing).
@@ -27,20 +26,8 @@ CELL_PER_SPACING = 0.6
 #: box half inside the samples' surface). Measured on 200,000 samples of a wavy cap in 8
 #: tiles: 20 spacings opened 4 slits along the seams, 40 gave one run's faces and loops exactly.
 HALO_SPACINGS = 40
-#: Samples whose neighbourhood sets the scan's spacing (the median of these is robust).
-SPACING_SEEDS = 20000
 #: Lattice cells between the samples' box and the lattice's border.
 MARGIN_CELLS = 4
-
-
-def median_spacing(points: np.ndarray, seeds: int = SPACING_SEEDS, seed: int = 0) -> float:
-    """The filter's sample spacing (spacing.h: sqrt(pi r8^2 / 8), r8 the distance to the 8th
-    nearest neighbour), as the median over up to `seeds` samples drawn from the (n, 3) points."""
-    points = np.asarray(points, dtype=np.float64)
-    rng = np.random.default_rng(seed)
-    at = points if len(points) <= seeds else points[rng.choice(len(points), seeds, replace=False)]
-    distance, _ = cKDTree(points).query(at, k=9)
-    return float(np.median(np.sqrt(np.pi * distance[:, 8] ** 2 / 8)))
 
 
 @dataclass
@@ -76,14 +63,16 @@ class Plan:
                     lattice_spacing=self.spacing, block_min=lo, block_max=hi)
 
 
-def plan(points: np.ndarray, resolution: int = 0, tiles: Optional[int] = None, tile_cells: int = 256,
-         spacing: Optional[float] = None) -> Plan:
-    """The lattice and blocks for the (n, 3) points: cells of 0.6 spacings (the filter's
-    automatic resolution, uncapped) or of longest side / `resolution`; blocks of about
-    `tile_cells` cells a side, or at least `tiles` blocks, the longest blocks split first."""
-    points = np.asarray(points, dtype=np.float64)
-    lo, hi = points.min(axis=0), points.max(axis=0)
-    spacing = median_spacing(points) if spacing is None else float(spacing)
+def plan(points, normals=None, resolution: int = 0, tiles: Optional[int] = None, tile_cells: int = 256) -> Plan:
+    """The lattice and blocks for the samples (an (n, 3) array or files; tile_input.survey reads
+    their box and spacing): cells of 0.6 spacings (the filter's automatic resolution, uncapped)
+    or of longest side / `resolution`; blocks of about `tile_cells` cells a side, or at least
+    `tiles` blocks, the longest blocks split first."""
+    lo, hi, spacing, _ = survey(points, normals)
+    return _plan(lo, hi, spacing, resolution, tiles, tile_cells)
+
+
+def _plan(lo, hi, spacing: float, resolution: int, tiles: Optional[int], tile_cells: int) -> Plan:
     if not spacing > 0:
         raise ValueError("the samples have no spacing (all at one position?)")
     cell = (hi - lo).max() / resolution if resolution else CELL_PER_SPACING * spacing
@@ -124,12 +113,6 @@ def _peak_resident_bytes() -> float:
     return 0.0
 
 
-def _tile_rows(points: np.ndarray, lo: np.ndarray, hi: np.ndarray, halo: float) -> np.ndarray:
-    """Rows (ascending, as one run sees them) of the samples in [lo - halo, hi + halo]."""
-    inside = np.all((points >= lo - halo) & (points <= hi + halo), axis=1)
-    return np.flatnonzero(inside)
-
-
 def _client(workers: Optional[int], scheduler: Optional[str]):
     """A Dask client: on the scheduler at `scheduler`, else on a local cluster of `workers`
     single-threaded worker processes (default: this machine's cores)."""
@@ -148,48 +131,71 @@ def _client(workers: Optional[int], scheduler: Optional[str]):
 def reconstruct(points_or_files: Union[np.ndarray, str, Sequence[str]], normals: Optional[np.ndarray] = None, *,
                 resolution: int = 0, tiles: Optional[int] = None, tile_cells: int = 256,
                 workers: Optional[int] = None, scheduler: Optional[str] = None, progress: bool = False,
-                output: Optional[str] = None, **filter_params) -> Reconstruction:
+                output: Optional[str] = None, viewpoint: Optional[np.ndarray] = None,
+                **filter_params) -> Reconstruction:
     """The surface with boundaries of a scan, reconstructed in tiles on Dask.
 
-    points_or_files: (n, 3) samples, or one or more point files (read with their normals);
-    normals: (n, 3) outward normals of the samples (required: orientations estimated tile by
-    tile would not agree across tiles). resolution: cells along the longest side (0: cells of
+    points_or_files: (n, 3) samples, or one or more point files (binary PLY and LAS/LAZ are
+    read in chunks; the samples are binned to tiles on disk); normals: (n, 3) outward normals
+    of the samples (files: their own), required unless a `viewpoint` (3,) is given: each tile
+    then estimates its samples' normals facing it (oriented by propagation instead, tiles
+    would not agree). resolution: cells along the longest side (0: cells of
     0.6 spacings, as the filter chooses, but without its cap of 1024); tiles: at least this
     many blocks, else blocks of about `tile_cells` cells a side; workers: local worker
     processes (default: the cores); scheduler: the address of an existing Dask scheduler
-    instead (every worker needs this package and pymeshlab); progress: Dask's progress bar;
+    instead (every worker needs this package and pymeshlab); progress: tiles done, on stderr;
     output: a .ply path: the surface is streamed there piece by piece and the returned
     Reconstruction holds no vertices or faces (its loops index the file's vertices);
     filter_params: the filter's other parameters by their pymeshlab names.
     Returns a Reconstruction whose info holds the plan and per-tile figures.
     """
-    facing = filter_params.get("normals") == Normals.FACING_VIEWPOINT
-    points, normals = _samples(points_or_files, normals, facing)
-    p = plan(points, resolution=resolution, tiles=tiles, tile_cells=tile_cells)
+    facing = viewpoint is not None
+    if facing:  # reconstruct() in the worker turns it into the filter's normals and viewpoint
+        filter_params["viewpoint"] = np.asarray(viewpoint, dtype=np.float64).reshape(3)
+    source = _source(points_or_files, normals)
+    lo, hi, spacing, with_normals = survey(source, normals)
+    if not with_normals and not facing:
+        raise ValueError("tiled reconstruction needs the samples' normals: estimated tile by tile and oriented "
+                         "by propagation, their orientations would not agree across tiles. Give the normals, "
+                         "or a viewpoint they face (viewpoint=...; the CLI's --viewpoint), or reconstruct "
+                         "in one run.")
+    p = _plan(lo, hi, spacing, resolution, tiles, tile_cells)
+    bins = Bins(p.planes, p.halo)
+    for points, given in chunks(source, normals):  # normals facing the viewpoint: zero, the filter's to fill
+        bins.add(points, given if given is not None else np.zeros_like(points))
     client, cluster = _client(workers, scheduler)
-    join = Join(1e-6 * p.cell)
+    join = Join(0.01 * p.cell)  # tile_join.py says why a hundredth
     try:
         from distributed import as_completed
-        futures, blocks = [], {}
-        for index, lo, hi in p.blocks():
-            rows = _tile_rows(points, lo, hi, p.halo)
-            if len(rows) < 20:  # the filter needs samples to fit planes; such a block holds no surface
-                continue
-            params = dict(filter_params, **p.filter_params(lo, hi))
-            future = client.submit(_reconstruct_tile, points[rows], normals[rows], params, pure=False)
-            futures.append(future)
-            blocks[future.key] = (index, len(rows))
-        if progress:
-            from distributed import progress as show
-            show(futures)
-        tile_info = []
-        for future in as_completed(futures):  # each piece to disk as it comes: the client holds one
+        # Tiles are read from their bins and submitted a few per worker ahead, so the client,
+        # the scheduler and the workers hold a few tiles' samples, never the scan's.
+        blocks = [(i, index, lo, hi) for i, (index, lo, hi) in enumerate(p.blocks()) if bins.counts[i] >= 20]
+        ahead = 2 * max(1, len(client.scheduler_info()["workers"]))
+        pending, futures, tile_info, what = iter(blocks), as_completed(), [], {}
+
+        def submit_next():
+            for t, index, lo, hi in pending:
+                points, normals = bins.samples(t)
+                future = client.submit(_reconstruct_tile, points, normals, dict(filter_params, **p.filter_params(lo, hi)),
+                                       pure=False)
+                what[future.key] = (index, len(points))
+                futures.add(future)
+                return
+
+        for _ in range(ahead):
+            submit_next()
+        bar = _Progress(len(blocks)) if progress else None
+        for future in futures:  # each piece to disk as it comes: the client holds one
             vertices, faces, info = future.result()
             join.add(vertices, faces)
-            tile_info.append(dict(block=blocks[future.key][0], samples=blocks[future.key][1],
-                                  faces=len(faces), seconds=sum(v for k, v in info.items() if k.startswith("seconds_")),
+            index, samples = what.pop(future.key)
+            tile_info.append(dict(block=index, samples=samples, faces=len(faces),
+                                  seconds=sum(v for k, v in info.items() if k.startswith("seconds_")),
                                   worker_peak_bytes=info["worker_peak_bytes"]))
             future.release()
+            submit_next()
+            if bar:
+                bar.step()
         loops = join.finish()
         if output is None:
             vertices, faces = join.arrays()
@@ -204,36 +210,36 @@ def reconstruct(points_or_files: Union[np.ndarray, str, Sequence[str]], normals:
         return Reconstruction(vertices, faces, loops, info)
     finally:
         join.close()
+        bins.close()
         client.close()
         if cluster is not None:
             cluster.close()
 
 
-def _samples(points_or_files, normals, facing: bool) -> Tuple[np.ndarray, np.ndarray]:
-    """(n, 3) points and normals from arrays or files. Normals are required, unless they are
-    estimated facing a viewpoint (`facing`): each tile then turns its estimates to face it, a
-    rule that needs no other tile (zero normals are returned for the filter to fill)."""
-    if isinstance(points_or_files, (str, os.PathLike)) or (
-            isinstance(points_or_files, (list, tuple)) and points_or_files and
-            isinstance(points_or_files[0], (str, os.PathLike))):
-        from .cloud import read_cloud
-        files = [points_or_files] if isinstance(points_or_files, (str, os.PathLike)) else list(points_or_files)
-        # Without normals: MeshLab's point-cloud normals, once per file (or none, when facing).
-        clouds = [read_cloud(f, estimate_normals=not facing) for f in files]
-        points = np.concatenate([c.points for c in clouds])
-        normals = np.concatenate([c.normals for c in clouds])
-    else:
-        points = np.ascontiguousarray(points_or_files, dtype=np.float64).reshape(-1, 3)
-    if normals is None and facing:
-        normals = np.zeros_like(points)
-    if normals is None:
-        raise ValueError("tiled reconstruction needs the samples' normals: estimated tile by tile and oriented "
-                         "by propagation, their orientations would not agree across tiles. Give the normals, "
-                         "or a viewpoint they face (normals=Normals.FACING_VIEWPOINT, viewpoint=...; the CLI's "
-                         "--viewpoint), or reconstruct in one run.")
-    normals = np.ascontiguousarray(normals, dtype=np.float64).reshape(-1, 3)
-    if normals.shape != points.shape:
-        raise ValueError(f"normals have shape {normals.shape}, points {points.shape}: one normal per point")
-    if not np.isfinite(points).all():
-        raise ValueError("some sample positions are NaN or infinite: remove them first")
-    return points, normals
+def _source(points_or_files, normals):
+    """The samples as tile_input.chunks reads them: an (n, 3) array (checked against its
+    normals) or a list of files."""
+    if isinstance(points_or_files, (str, os.PathLike)):
+        return [points_or_files]
+    if isinstance(points_or_files, (list, tuple)) and points_or_files and \
+            isinstance(points_or_files[0], (str, os.PathLike)):
+        return list(points_or_files)
+    points = np.ascontiguousarray(points_or_files, dtype=np.float64).reshape(-1, 3)
+    if normals is not None and np.shape(normals) != points.shape:
+        raise ValueError(f"normals have shape {np.shape(normals)}, points {points.shape}: one normal per point")
+    return points
+
+
+class _Progress:
+    """Tiles done, on stderr (the CLI's bar)."""
+
+    def __init__(self, total: int):
+        self.total, self.done = total, 0
+
+    def step(self) -> None:
+        import sys
+        self.done += 1
+        sys.stderr.write(f"\rtiles {self.done}/{self.total}")
+        if self.done == self.total:
+            sys.stderr.write("\n")
+        sys.stderr.flush()
