@@ -192,3 +192,9 @@ def test_binary_ply_is_read_in_chunks_and_binned_to_every_tile_whose_halo_holds_
         got, _ = bins.samples(t)
         np.testing.assert_array_equal(got, stored[expected])  # the same rows, in input order
     bins.close()
+
+
+def test_a_tiles_error_says_which_tile_and_why(plugin, cap):
+    points, normals = cap
+    with pytest.raises(ValueError, match=r"(?s)tile \(\d, \d, \d\) \(\d+ samples\):.*Boundary smoothing must be"):
+        tiled.reconstruct(points[:20_000], normals[:20_000], tiles=2, workers=1, boundary_smoothing=500)

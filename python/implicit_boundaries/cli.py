@@ -217,7 +217,7 @@ def _parser() -> argparse.ArgumentParser:
                                             "any other format pymeshlab reads), or --viewpoint for normals to face")
     t.add_argument("-o", "--output", required=True)
     t.add_argument("--tiles", type=int, help="at least this many tiles (default: tiles of --tile-cells cells a side)")
-    t.add_argument("--tile-cells", type=int, default=256, help="lattice cells along a tile's side (default 256)")
+    t.add_argument("--tile-cells", type=int, default=512, help="lattice cells along a tile's side (default 512)")
     engine = t.add_mutually_exclusive_group()
     engine.add_argument("--workers", type=int, help="local Dask worker processes (default: the cores)")
     engine.add_argument("--scheduler", metavar="ADDRESS",

@@ -63,7 +63,7 @@ class Plan:
                     lattice_spacing=self.spacing, block_min=lo, block_max=hi)
 
 
-def plan(points, normals=None, resolution: int = 0, tiles: Optional[int] = None, tile_cells: int = 256) -> Plan:
+def plan(points, normals=None, resolution: int = 0, tiles: Optional[int] = None, tile_cells: int = 512) -> Plan:
     """The lattice and blocks for the samples (an (n, 3) array or files; tile_input.survey reads
     their box and spacing): cells of 0.6 spacings (the filter's automatic resolution, uncapped)
     or of longest side / `resolution`; blocks of about `tile_cells` cells a side, or at least
@@ -129,7 +129,7 @@ def _client(workers: Optional[int], scheduler: Optional[str]):
 
 
 def reconstruct(points_or_files: Union[np.ndarray, str, Sequence[str]], normals: Optional[np.ndarray] = None, *,
-                resolution: int = 0, tiles: Optional[int] = None, tile_cells: int = 256,
+                resolution: int = 0, tiles: Optional[int] = None, tile_cells: int = 512,
                 workers: Optional[int] = None, scheduler: Optional[str] = None, progress: bool = False,
                 output: Optional[str] = None, viewpoint: Optional[np.ndarray] = None,
                 **filter_params) -> Reconstruction:
@@ -186,9 +186,12 @@ def reconstruct(points_or_files: Union[np.ndarray, str, Sequence[str]], normals:
             submit_next()
         bar = _Progress(len(blocks)) if progress else None
         for future in futures:  # each piece to disk as it comes: the client holds one
-            vertices, faces, info = future.result()
-            join.add(vertices, faces)
             index, samples = what.pop(future.key)
+            try:
+                vertices, faces, info = future.result()
+            except Exception as e:  # the filter's message, with the tile it is about
+                raise ValueError(f"tile {index} ({samples} samples): {e}") from e
+            join.add(vertices, faces)
             tile_info.append(dict(block=index, samples=samples, faces=len(faces),
                                   seconds=sum(v for k, v in info.items() if k.startswith("seconds_")),
                                   worker_peak_bytes=info["worker_peak_bytes"]))
