@@ -10,6 +10,7 @@ the client's (this process: the plan, the bins, the join).
     python bench/tiled.py --sizes 1000000 2000000 4000000 --tiles 0 --resolution 0 --skip-single
 """
 import argparse
+import shutil
 import sys
 import tempfile
 import time
@@ -89,6 +90,8 @@ def main(argv=None):
                   f"{t.info['face_count']:,}, {tiled_seconds:.1f}, {t.info['worker_peak_bytes'] / 2**30:.2f} "
                   f"(client {client_gb:.2f}) | {far} | {ratio} |", flush=True)
             del t
+        if args.skip_single:
+            shutil.rmtree(folder)
 
 if __name__ == "__main__":
     main()
