@@ -57,6 +57,32 @@ def test_seams_hold_no_border_edge(cap, joined):
     assert np.count_nonzero(border[:, 2] > -0.15) == sum(len(loop) for loop in joined.loops[1:])
 
 
+def test_holes_across_seams_are_filled_or_kept_as_one_run_decides(plugin):
+    # Holes cut into a terrain right on the seams of its 4 tiles, from 2 to 5 spacings in
+    # radius: each tile decides with its halo which of them are undersampling (filled) and which
+    # stay open, and the joined surface has one run's loops, edge for edge, and its faces.
+    spacing = 0.006
+    points, normals = terrain_with_pond(spacing=spacing, noise=0.0, seed=1)
+    x, y = (tiled.plan(points, tiles=4).planes[a][1] for a in range(2))
+    holes = [((x, 0.15), 5.0), ((x, 0.8), 2.0), ((x, 0.92), 2.4), ((0.1, y), 2.2), ((0.25, y), 2.6), ((0.35, y), 4.0)]
+    keep = np.ones(len(points), dtype=bool)
+    for (cx, cy), radius in holes:
+        keep &= np.hypot(points[:, 0] - cx, points[:, 1] - cy) > radius * spacing
+    points, normals = points[keep], normals[keep]
+    p = tiled.plan(points, tiles=4)
+    assert np.allclose([p.planes[0][1], p.planes[1][1]], [x, y], atol=p.cell)
+    one = reconstruct(points, normals, **p.filter_params(p.origin, p.origin), **UNSMOOTHED)
+    joined = tiled.reconstruct(points, normals, tiles=4, workers=2, **UNSMOOTHED)
+    assert [len(loop) for loop in joined.loops] == [len(loop) for loop in one.loops]
+    assert len(joined.faces) == len(one.faces)
+    # The border and the pond, and three of the cut holes; the two smallest were filled.
+    assert len(one.loops) == 5 and one.info["holes_filled"] >= 2
+    seam_loops = [joined.vertices[loop] for loop in joined.loops if len(loop) < 200]
+    assert len(seam_loops) == 3
+    for loop in seam_loops:  # each one straddles a seam
+        assert any(loop[:, a].min() < plane < loop[:, a].max() for a, plane in ((0, x), (1, y)))
+
+
 def test_the_plan_covers_every_sample_with_grid_aligned_blocks(cap):
     points, _ = cap
     p = tiled.plan(points, tiles=8)
