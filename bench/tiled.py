@@ -7,7 +7,7 @@ loops and faces of both, how far the tiled surface's vertices lie from the one r
 the client's (this process: the plan, the bins, the join).
 
     python bench/tiled.py [--sizes 1000000 5000000] [--tiles 8] [--workers 1 2] [--resolution 1024]
-    python bench/tiled.py --sizes 1000000 2000000 4000000 --tiles 0 --resolution 0 --skip-single
+    python bench/tiled.py --sizes 1000000 2000000 4000000 --tiles 0 --resolution 0 --skip-single [--las]
 """
 import argparse
 import shutil
@@ -43,6 +43,21 @@ def write_ply(path: Path, points: np.ndarray, normals: np.ndarray) -> Path:
     return path
 
 
+def write_las(path: Path, points: np.ndarray, normals: np.ndarray) -> Path:
+    """The samples as a LAS 1.4 file (coordinates to a millionth of the scan's extent), the
+    normals as the extra dimensions nx, ny, nz (what tile_input reads as normals)."""
+    import laspy
+    header = laspy.LasHeader(point_format=6, version="1.4")
+    header.offsets = points.min(axis=0)
+    header.scales = np.full(3, 1e-6 * np.ptp(points, axis=0).max())
+    header.add_extra_dims([laspy.ExtraBytesParams(name=c, type=np.float64) for c in ("nx", "ny", "nz")])
+    las = laspy.LasData(header)
+    las.x, las.y, las.z = points[:, 0], points[:, 1], points[:, 2]
+    las.nx, las.ny, las.nz = normals[:, 0], normals[:, 1], normals[:, 2]
+    las.write(str(path))
+    return path
+
+
 def main(argv=None):
     a = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     a.add_argument("--sizes", type=int, nargs="+", default=[1_000_000, 5_000_000])
@@ -53,6 +68,7 @@ def main(argv=None):
                    help="cells along the longest side (0: 0.6 spacings, uncapped); 1024 = one run's automatic cap")
     a.add_argument("--skip-single", action="store_true",
                    help="only the tiled run, from a binary PLY file written first, to a PLY file (sizes one run cannot do)")
+    a.add_argument("--las", action="store_true", help="with --skip-single: the scan as a LAS file instead of binary PLY")
     args = a.parse_args(argv)
     print("| samples | workers | tiles | cell | one run: loops, faces, s, peak GB | tiled: loops, faces, s, peak GB per worker "
           "| farthest vertex (cells) | tiled / one run time |")
@@ -71,7 +87,9 @@ def main(argv=None):
         source, output = (points, normals), None
         if args.skip_single:  # the scan on disk, as a user's would be, and the surface streamed there
             folder = tempfile.mkdtemp(prefix="bench-tiled-")
-            source, output = ([write_ply(Path(folder) / "scan.ply", points, normals)], None), str(Path(folder) / "out.ply")
+            scan = (write_las(Path(folder) / "scan.las", points, normals) if args.las
+                    else write_ply(Path(folder) / "scan.ply", points, normals))
+            source, output = ([scan], None), str(Path(folder) / "out.ply")
             del points, normals
         for workers in args.workers:
             Path("/proc/self/clear_refs").write_text("5")
