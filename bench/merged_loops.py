@@ -51,18 +51,27 @@ def hole_regions(vertices, faces):
     return connected_components(graph, directed=False)[1][faces[:, 0]]
 
 
-def seen_empty(centres, face_normals, points, normals, spacing):
-    """Per hole face, whether this scan faced it with none of its samples in front of it (along
-    its view, the mean of its normals: a range scanner's normals face it)."""
-    view = normals[np.linalg.norm(normals, axis=1) > 0].mean(0)
-    view /= np.linalg.norm(view)
-    u = np.cross(view, [1, 0, 0] if abs(view[0]) < 0.9 else [0, 1, 0])
-    u /= np.linalg.norm(u)
-    w = np.cross(view, u)
-    across, depth = cKDTree(np.c_[points @ u, points @ w]), points @ view
-    rays = across.query_ball_point(np.c_[centres @ u, centres @ w], 1.5 * spacing)
-    front = np.array([len(r) > 0 and depth[r].max() > d + 3 * spacing for r, d in zip(rays, centres @ view)])
-    return (np.abs(face_normals @ view) > 0.3) & ~front
+class ScanView:
+    """One scan seen along its view (the mean of its normals: a range scanner's normals face
+    it): its samples projected across the view, and their depth along it."""
+
+    def __init__(self, points, normals, spacing):
+        view = normals[np.linalg.norm(normals, axis=1) > 0].mean(0)
+        self.view = view / np.linalg.norm(view)
+        u = np.cross(self.view, [1, 0, 0] if abs(self.view[0]) < 0.9 else [0, 1, 0])
+        self.u = u / np.linalg.norm(u)
+        self.w = np.cross(self.view, self.u)
+        self.across = cKDTree(np.c_[points @ self.u, points @ self.w])
+        self.depth = points @ self.view
+        self.spacing = spacing
+
+    def seen_empty(self, centres, face_normals):
+        """Per hole face, whether the scan faced it (|cos| over 0.3) with none of its samples in
+        front of it."""
+        rays = self.across.query_ball_point(np.c_[centres @ self.u, centres @ self.w], 1.5 * self.spacing)
+        front = np.array([len(r) > 0 and self.depth[r].max() > d + 3 * self.spacing
+                          for r, d in zip(rays, centres @ self.view)])
+        return (np.abs(face_normals @ self.view) > 0.3) & ~front
 
 
 def main(argv=None):
@@ -81,15 +90,17 @@ def main(argv=None):
     samples = np.vstack([p for p, _ in scans])
     scan_of = np.concatenate([np.full(len(p), i) for i, (p, _) in enumerate(scans)])
     index = cKDTree(samples)
-    own_spacing = [np.median(cKDTree(p).query(p, 2)[0][:, 1]) for p, _ in scans]
-    spacing = np.concatenate([cKDTree(p).query(p, 2)[0][:, 1] for p, _ in scans])
+    per_scan = [cKDTree(p).query(p, 2)[0][:, 1] for p, _ in scans]  # each sample's spacing within its scan
+    own_spacing = [np.median(d) for d in per_scan]
+    spacing = np.concatenate(per_scan)
+    views = [ScanView(p, n, h) for (p, n), h in zip(scans, own_spacing)]
     region = hole_regions(hole_vertices, hole_faces)
     centres = hole_vertices[hole_faces].mean(1)
     face_normals = np.cross(hole_vertices[hole_faces[:, 1]] - hole_vertices[hole_faces[:, 0]],
                             hole_vertices[hole_faces[:, 2]] - hole_vertices[hole_faces[:, 0]])
     face_normals /= np.maximum(np.linalg.norm(face_normals, axis=1), 1e-300)[:, None]
     tolerance = 2.5 * info["sample_spacing"] + 2 * info["cell_size"]
-    true_loops = [truth_vertices[s] for s in metrics.boundary_vertex_sets(truth_faces, len(truth_vertices))]
+    true_loops = [cKDTree(truth_vertices[s]) for s in metrics.boundary_vertex_sets(truth_faces, len(truth_vertices))]
     truth_centres = cKDTree(truth_vertices[truth_faces].mean(1))
     truth_edge = np.linalg.norm(truth_vertices[truth_faces] - truth_vertices[np.roll(truth_faces, 1, axis=1)], axis=2).max(1)
 
@@ -100,13 +111,13 @@ def main(argv=None):
     print("|---|---|---|---|---|---|---|")
     for loop in metrics.boundary_vertex_sets(faces, len(vertices)):
         points = vertices[loop]
-        has = any(cKDTree(t).query(points)[0].mean() < tolerance for t in true_loops)
+        has = any(t.query(points)[0].mean() < tolerance for t in true_loops)
         near = cKDTree(points).query(centres)[0] < 2 * np.mean(own_spacing)
         mine = np.isin(region, np.unique(region[near]))
         rim = np.unique(np.concatenate([np.asarray(r, int) for r in index.query_ball_point(points, 2 * np.mean(own_spacing))]))
         depth, _ = index.query(centres[mine])
-        looked = [f"{i}: {s:.0%}" for i, (p, n) in enumerate(scans)
-                  if (s := seen_empty(centres[mine], face_normals[mine], p, n, own_spacing[i]).mean()) >= 0.2]
+        looked = [f"{i}: {s:.0%}" for i, v in enumerate(views)
+                  if (s := v.seen_empty(centres[mine], face_normals[mine]).mean()) >= 0.2]
         middle = centres[mine][depth > 0.5 * depth.max()]
         gap, over = truth_centres.query(middle)
         over = np.unique(over[gap < 2 * np.mean(own_spacing)])
