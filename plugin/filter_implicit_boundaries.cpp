@@ -318,6 +318,9 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 		r.boundary.holes_filled, p.min_boundary_edges, r.boundary.faces_trimmed, r.boundary.boundary_vertices_fitted);
 	if (r.boundary.largest_hole_filled > 0 || r.boundary.smallest_hole_kept > 0)
 		log("%s", qUtf8Printable(holeMargins(r.boundary, p.min_boundary_edges)));
+	if (r.openings.closed > 0)
+		log("Closed %d openings among samples (a thin part or a crease the gate opened: no point of their span "
+			"is farther than %g median spacings from a sample).", r.openings.closed, ib::CoveredOpenings::kReach);
 	if (r.faces_not_manifold > 0 || r.vertices_split > 0)
 		log("Made the surface a 2-manifold: removed %zu faces from edges shared by more than two faces, split %zu "
 			"vertices where separate fans met.", r.faces_not_manifold, r.vertices_split);
@@ -345,6 +348,8 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 	res["boundary_loops_before_filling"] = QVariant::fromValue(toVector(
 		std::vector<double>(r.boundary.loops_before_filling.begin(), r.boundary.loops_before_filling.end())));
 	res["holes_filled"] = r.boundary.holes_filled;
+	res["openings_closed"] = r.openings.closed;
+	res["closest_opening_kept_spacings"] = r.openings.closest_kept;
 	res["largest_hole_filled_edges"] = r.boundary.largest_hole_filled;
 	res["smallest_hole_kept_edges"] = r.boundary.smallest_hole_kept;
 	res["hole_faces"] = holes.fn;

@@ -5,6 +5,7 @@
 /// Throws ib::InputError, with a message that says what is wrong and what to do, on bad input.
 
 #include "boundary_stage.h"
+#include "covered_openings.h"
 #include "gated_mc.h"
 #include "implicit/hoppe.h"
 #include "implicit/pu_rbf.h"
@@ -63,6 +64,7 @@ public:
     {
         std::vector<BoundaryLoop> loops;  ///< boundary loops of the surface, largest first
         BoundaryStage::Result boundary;   ///< holes filled, faces trimmed, loops fitted
+        CoveredOpenings::Result openings;  ///< openings among samples closed (covered_openings.h)
         size_t seam_points = 0;           ///< where neighbouring samples' normals flip (orientation_seam.h)
         size_t covered_scan_edges = 0;    ///< merged scans: edge samples another scan covers, left out of the PU-RBF's fit
         size_t duplicates_removed = 0;    ///< samples at the same position as an earlier one
@@ -229,6 +231,11 @@ private:
         if (holes)
             BoundaryStage::SplitHoles(surface, inSurface, *holes);
         BoundaryStage::KeepSurface(surface, inSurface);
+        // On the whole surface, before a tile's clip: the halo sees a seam's openings whole.
+        // A mesh's triangles already say where its holes are (mesh_holes.h), and a
+        // min_boundary_edges of 0 keeps every opening.
+        if (!triangles && p.min_boundary_edges > 0 && p.extraction != GatedMarchingCubes::Extraction::Plain)
+            r.openings = CoveredOpenings::Compute(surface, samples, r.sample_spacing);
         p.tile.Clip(surface);
         if (holes)
             p.tile.Clip(*holes);

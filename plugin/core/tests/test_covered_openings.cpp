@@ -1,0 +1,91 @@
+// Openings among samples closed: flat grids and a sphere with faces cut out, samples at their
+// vertices (with or without the cut-out part's).
+#include "covered_openings.h"
+#include "geometry.h"
+
+#include <gtest/gtest.h>
+
+using namespace ib;
+
+namespace {
+
+/// The vertices of m as samples.
+Points VerticesOf(const CoreMesh& m)
+{
+    Points P(Eigen::Index(m.vert.size()), 3);
+    for (size_t i = 0; i < m.vert.size(); ++i)
+        P.row(Eigen::Index(i)) = PositionOf(m, int(i)).transpose();
+    return P;
+}
+
+/// Deletes the faces of m whose centre lies within `radius` of `centre`, and the vertices left
+/// unused; rebuilds the face-face adjacency.
+void CutOut(CoreMesh& m, const vcg::Point3d& centre, double radius)
+{
+    for (CoreFace& f : m.face)
+        if (vcg::Distance(vcg::Barycenter(f), centre) < radius)
+            vcg::tri::Allocator<CoreMesh>::DeleteFace(m, f);
+    vcg::tri::Clean<CoreMesh>::RemoveUnreferencedVertex(m);
+    vcg::tri::Allocator<CoreMesh>::CompactEveryVector(m);
+    vcg::tri::UpdateTopology<CoreMesh>::FaceFace(m);
+}
+
+} // namespace
+
+TEST(CoveredOpenings, AnOpeningAmongSamplesIsClosedAndTheRimKept)
+{
+    CoreMesh m;
+    test::Grid(20, 1.0, m);
+    const Points P = VerticesOf(m);  // with the samples where the faces are cut out
+    CutOut(m, vcg::Point3d(10, 10, 0), 1.2);
+    ASSERT_EQ(BoundaryLoops::Compute(m).size(), 2u);
+    const SampleIndex samples(P);
+    const CoveredOpenings::Result r = CoveredOpenings::Compute(m, samples, 1.0);
+    EXPECT_EQ(r.closed, 1);
+    const std::vector<BoundaryLoop> loops = BoundaryLoops::Compute(m);
+    ASSERT_EQ(loops.size(), 1u);
+    EXPECT_EQ(loops[0].Edges(), 80);  // the grid's rim, whose fan lies on the grid among samples
+    const test::Topology t = test::Check(m);
+    EXPECT_EQ(t.non_manifold_edges, 0);
+    EXPECT_EQ(t.non_manifold_vertices, 0);
+    EXPECT_TRUE(t.oriented);
+    double area = 0;
+    for (const CoreFace& f : m.face)
+        area += 0.5 * vcg::DoubleArea(f);
+    EXPECT_NEAR(area, 400.0, 1e-9);  // the patch lies in the plane, over the cut
+}
+
+TEST(CoveredOpenings, AHoleWithNoSampleInItIsKept)
+{
+    CoreMesh m;
+    test::Grid(20, 1.0, m);
+    CutOut(m, vcg::Point3d(10, 10, 0), 3.0);
+    const Points P = VerticesOf(m);  // none inside the hole
+    const SampleIndex samples(P);
+    const std::vector<BoundaryLoop> before = BoundaryLoops::Compute(m);
+    ASSERT_EQ(before.size(), 2u);
+    EXPECT_GT(CoveredOpenings::Reach(m, before[1], samples, 1.0, 10.0), 2.0);  // about the hole's radius
+    const size_t faces = m.face.size();
+    const CoveredOpenings::Result r = CoveredOpenings::Compute(m, samples, 1.0);
+    EXPECT_EQ(r.closed, 0);
+    EXPECT_GT(r.closest_kept, 2.0);
+    EXPECT_EQ(BoundaryLoops::Compute(m).size(), 2u);
+    EXPECT_EQ(m.face.size(), faces);
+}
+
+TEST(CoveredOpenings, AnOpeningInAClosedSurfaceIsClosed)
+{
+    CoreMesh m;
+    vcg::tri::Sphere(m, 4);
+    vcg::tri::UpdateTopology<CoreMesh>::FaceFace(m);
+    const Points P = VerticesOf(m);
+    const double spacing = vcg::Distance(m.face[0].cP(0), m.face[0].cP(1));
+    CutOut(m, m.vert[0].cP(), 1.6 * spacing);
+    ASSERT_EQ(BoundaryLoops::Compute(m).size(), 1u);
+    const SampleIndex samples(P);
+    EXPECT_EQ(CoveredOpenings::Compute(m, samples, spacing).closed, 1);
+    EXPECT_TRUE(BoundaryLoops::Compute(m).empty());
+    const test::Topology t = test::Check(m);
+    EXPECT_EQ(t.non_manifold_edges + t.non_manifold_vertices + t.border_edges, 0);
+    EXPECT_TRUE(t.oriented);
+}
