@@ -320,7 +320,11 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 		log("%s", qUtf8Printable(holeMargins(r.boundary, p.min_boundary_edges)));
 	if (r.openings.closed > 0)
 		log("Closed %d openings among samples (a thin part or a crease the gate opened: no point of their span "
-			"is farther than %g median spacings from a sample).", r.openings.closed, ib::CoveredOpenings::kReach);
+			"is farther from a sample than %g median spacing or the surface around them is).", r.openings.closed,
+			ib::CoveredOpenings::kReach);
+	if (r.openings.closest_kept > 0)
+		log("The opening kept that came closest to being closed reaches %.2f times as far from the samples as "
+			"the rule allows (the surface around it, at least one median spacing).", r.openings.closest_kept);
 	if (r.faces_not_manifold > 0 || r.vertices_split > 0)
 		log("Made the surface a 2-manifold: removed %zu faces from edges shared by more than two faces, split %zu "
 			"vertices where separate fans met.", r.faces_not_manifold, r.vertices_split);
@@ -349,7 +353,7 @@ std::map<std::string, QVariant> FilterImplicitBoundariesPlugin::reconstructWithB
 		std::vector<double>(r.boundary.loops_before_filling.begin(), r.boundary.loops_before_filling.end())));
 	res["holes_filled"] = r.boundary.holes_filled;
 	res["openings_closed"] = r.openings.closed;
-	res["closest_opening_kept_spacings"] = r.openings.closest_kept;
+	res["closest_opening_kept"] = r.openings.closest_kept;
 	res["largest_hole_filled_edges"] = r.boundary.largest_hole_filled;
 	res["smallest_hole_kept_edges"] = r.boundary.smallest_hole_kept;
 	res["hole_faces"] = holes.fn;

@@ -131,17 +131,18 @@ def test_a_layer_of_zero_area_faces_says_what_to_do(plugin):
 @pytest.mark.parametrize("implicit", [Implicit.PU_RBF, Implicit.HOPPE])
 def test_implicit_is_chosen_by_name(plugin, implicit):
     """Both implicit functions by name on the bunny: the result says which ran (and the PU-RBF's
-    local fits), 3 real holes come out as loops at their place (not the same 3: Hoppe's third is
-    a 25-edge loop where its zero set folds inside a gap 1.09 spacings from a sample, which the
-    PU-RBF, smooth there, closes as undersampling; the PU-RBF's is 12 edges in a slit), and no
-    loop appears anywhere else (the PU-RBF's regularisation was 1e-6 here once: its zero set
-    bulged past the rim of an ear and left a spurious loop there)."""
+    local fits), the real holes deeper than the sampling's own gaps come out as loops at their
+    place, and no loop appears anywhere else (the PU-RBF's regularisation was 1e-6 here once:
+    its zero set bulged past the rim of an ear and left a spurious loop there). The PU-RBF
+    keeps a third, 12 edges in a slit; Hoppe's zero set folds inside the other slit (a 25-edge
+    loop, a gap 1.27 spacings deep), but no farther from the samples than its surface around
+    it, so that opening is closed as one among samples (covered_openings.h)."""
     result, found, spurious = bunny_holes(implicit=implicit)
     rbf = implicit == Implicit.PU_RBF
     assert result["implicit"] == (0 if rbf else 1)
     assert (result["rbf_cells"] > 10) == rbf and result["rbf_cells"] >= 0
     assert not spurious, f"loops of {spurious} edges far from every real hole"
-    assert len(found) >= 3 and sum(max(v) >= 15 for v in found.values()) >= (2 if rbf else 3)
+    assert len(found) >= (3 if rbf else 2) and sum(max(v) >= 15 for v in found.values()) >= 2
 
 
 def test_small_holes_are_filled_only_below_the_threshold(plugin):
