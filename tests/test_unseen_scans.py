@@ -134,6 +134,22 @@ def test_a_narrow_v_groove_keeps_only_its_rim():
     assert np.min(np.maximum(np.abs(rim[:, 1]), np.linalg.norm(rim[:, [0, 2]], axis=1))) > 0.9  # all at the sheet's edge
 
 
+@pytest.mark.parametrize("noise", [0.0, 0.002])
+@pytest.mark.parametrize("given_normals", [True, False], ids=["given normals", "estimated normals"])
+def test_a_terrain_keeps_its_border_and_its_pond(noise, given_normals):
+    """A flat open scan (a terrain) with a round pond, clean and with noise of 0.2% of its
+    diagonal (0.3 spacings), normals given or estimated: two loops, the border and the
+    pond, each where it is (7 loops with noise when the issue was filed)."""
+    points, normals = shapes.terrain_with_pond(noise=noise)
+    rec = implicit_boundaries.reconstruct(points, normals if given_normals else None)
+    assert len(rec.loops) == 2
+    pond = min(rec.loops, key=len)
+    radius = np.hypot(rec.vertices[pond][:, 0] - 0.6, rec.vertices[pond][:, 1] - 0.4)
+    assert np.abs(radius - 0.15).max() < 2 * rec.info["sample_spacing"]
+    border = rec.vertices[max(rec.loops, key=len)][:, :2]
+    assert np.minimum(np.abs(border), np.abs(border - 1)).min(axis=1).max() < 2 * rec.info["sample_spacing"]
+
+
 def test_a_resolution_set_finer_than_the_spacing_keeps_the_surface_whole():
     """Random samples of a smooth cap with one rim, the resolution set by hand to 4 times the
     automatic one (cells a quarter of the automatic cell): one loop, the rim. The tangent disks

@@ -76,10 +76,12 @@ public:
     };
 
     /// Closes the openings of `mesh` (an oriented 2-manifold with boundary, face-face adjacency
-    /// up to date) among `samples` (median local spacing `spacing`). Loops that pass a vertex
-    /// twice or touch another loop are left as they are. Face-face adjacency is rebuilt when
-    /// anything is closed.
-    static Result Compute(CoreMesh& mesh, const SampleIndex& samples, double spacing)
+    /// up to date) among `samples` (median local spacing `spacing`; `local`, when given, each
+    /// sample's own: the band around a loop in a sparser part is as many of its spacings wide).
+    /// Loops that pass a vertex twice or touch another loop are left as they are. Face-face
+    /// adjacency is rebuilt when anything is closed.
+    static Result Compute(CoreMesh& mesh, const SampleIndex& samples, double spacing,
+                          const Eigen::VectorXd* local = nullptr)
     {
         Result r;
         if (!(spacing > 0) || mesh.face.empty())
@@ -105,8 +107,9 @@ public:
             const double area = pieceArea[size_t(piece[size_t(faceOfVertex[size_t(loop.vertices[0])])])];
             if (FanArea(mesh, loop) >= kOutsideFan * area)
                 continue;
+            const double band = kBand * std::max(spacing, local ? SpacingAt(mesh, loop, samples, *local) : 0.0);
             const double limit =
-                std::max(kReach, SurfaceGap(mesh, loop, faceOfVertex, samples, kBand * spacing, kProbeStep * spacing) / spacing);
+                std::max(kReach, SurfaceGap(mesh, loop, faceOfVertex, samples, band, kProbeStep * spacing) / spacing);
             const double reach = Reach(mesh, loop, samples, spacing, limit) / spacing;
             if (reach <= limit)
                 close.push_back(&loop);
@@ -133,7 +136,8 @@ public:
     }
 
     /// How far the fan from the centroid of `loop` (vertices of `mesh`) to its edges gets from
-    /// `samples`: the largest distance from a probe point to its nearest sample. Probes are
+    /// `samples`: the largest distance from a probe point to its nearest sample, the loop's own
+    /// edges left out (they are the surface around's, which SurfaceGap measures). Probes are
     /// kProbeStep × `spacing` apart; stops early, with a value above `limit` × `spacing`, once
     /// one is that far.
     static double Reach(const CoreMesh& mesh, const BoundaryLoop& loop, const SampleIndex& samples, double spacing,
@@ -146,7 +150,7 @@ public:
         const size_t n = loop.vertices.size();
         for (size_t i = 0; i < n && reach <= limit * spacing; ++i)
             reach = std::max(reach, Farthest(c, PositionOf(mesh, loop.vertices[i]), PositionOf(mesh, loop.vertices[(i + 1) % n]),
-                                             samples, kProbeStep * spacing, limit * spacing, queue));
+                                             samples, kProbeStep * spacing, limit * spacing, queue, false));
         return reach;
     }
 
@@ -187,16 +191,34 @@ public:
     }
 
 private:
+    /// The median of the `local` spacings of the samples nearest to the vertices of `loop`.
+    static double SpacingAt(const CoreMesh& mesh, const BoundaryLoop& loop, const SampleIndex& samples,
+                            const Eigen::VectorXd& local)
+    {
+        std::vector<double> around;
+        SampleIndex::Queue queue;
+        for (int v : loop.vertices) {
+            samples.Nearest(PositionOf(mesh, v), 1, queue);
+            around.push_back(local[Eigen::Index(queue.getIndex(0))]);
+        }
+        std::nth_element(around.begin(), around.begin() + long(around.size() / 2), around.end());
+        return around[around.size() / 2];
+    }
+
     /// The largest distance from points of the triangle a b c (a barycentric grid `step` apart
     /// at most) to their nearest sample; stops early, above `limit`, once one is that far.
+    /// `withSideBC` false leaves the side b c out (the loop's own edge, for a fan: the surface
+    /// around the loop holds it).
     static double Farthest(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
-                           const SampleIndex& samples, double step, double limit, SampleIndex::Queue& queue)
+                           const SampleIndex& samples, double step, double limit, SampleIndex::Queue& queue,
+                           bool withSideBC = true)
     {
         const double longest = std::max({(b - a).norm(), (c - a).norm(), (c - b).norm()});
         const int steps = std::max(1, int(std::ceil(longest / step)));
+        const int last = withSideBC ? steps : steps - 1;
         double farthest = 0;
-        for (int u = 0; u <= steps && farthest <= limit; ++u)
-            for (int w = 0; u + w <= steps; ++w) {
+        for (int u = 0; u <= last && farthest <= limit; ++u)
+            for (int w = 0; u + w <= last; ++w) {
                 samples.Nearest(a + (b - a) * (double(u) / steps) + (c - a) * (double(w) / steps), 1, queue);
                 farthest = std::max(farthest, std::sqrt(queue.getWeight(0)));
             }

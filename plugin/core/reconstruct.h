@@ -235,7 +235,7 @@ private:
         // A mesh's triangles already say where its holes are (mesh_holes.h), and a
         // min_boundary_edges of 0 keeps every opening.
         if (!triangles && p.min_boundary_edges > 0 && p.extraction != GatedMarchingCubes::Extraction::Plain)
-            r.openings = CoveredOpenings::Compute(surface, samples, r.sample_spacing);
+            r.openings = CoveredOpenings::Compute(surface, samples, r.sample_spacing, &spacing);
         p.tile.Clip(surface);
         if (holes)
             p.tile.Clip(*holes);
