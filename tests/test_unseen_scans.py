@@ -134,6 +134,22 @@ def test_a_narrow_v_groove_keeps_only_its_rim():
     assert np.min(np.maximum(np.abs(rim[:, 1]), np.linalg.norm(rim[:, [0, 2]], axis=1))) > 0.9  # all at the sheet's edge
 
 
+@pytest.mark.parametrize("ratio", [5, 10])
+def test_a_scan_sparser_on_one_half_keeps_only_its_rim(ratio):
+    """A hemisphere sampled 5 or 10 times more sparsely (in spacing) on one half than on the
+    other, the density changing abruptly (a range grid at a fold): one loop, the rim. The
+    sparse samples next to the dense half see dense neighbours, so their tangent disks stay
+    small and leave gaps along the change, where the trim, seeing only dense samples nearby, peeled
+    a strip open between the halves (2 loops at 10 times, the halves apart). It now looks across
+    the gap and finds the sparser part."""
+    points, normals = shapes.uneven_hemisphere(ratio)
+    rec = implicit_boundaries.reconstruct(points, normals)
+    assert len(rec.loops) == 1
+    rim = rec.vertices[rec.loops[0]]
+    assert np.median(rim[:, 2]) < 0.05  # the rim, at z = 0 (jagged on the sparse half)
+    assert np.abs(np.linalg.norm(rec.vertices, axis=1) - 1).max() < 0.01
+
+
 @pytest.mark.parametrize("noise", [0.0, 0.002])
 @pytest.mark.parametrize("given_normals", [True, False], ids=["given normals", "estimated normals"])
 def test_a_terrain_keeps_its_border_and_its_pond(noise, given_normals):

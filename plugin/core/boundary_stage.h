@@ -125,7 +125,8 @@ public:
             r.faces_cut_at_mesh_holes =
                 MeshHoles::Cut(all, *p.input_mesh, p.cell_size, p.min_boundary_edges, inSurface);
         if (p.boundary_trim > 0)
-            r.faces_trimmed = BoundaryTrim::Compute(all, samples, p.boundary_trim * spacing, inSurface, p.threads);
+            r.faces_trimmed =
+                BoundaryTrim::Compute(all, samples, p.boundary_trim * spacing, inSurface, p.threads, &spacing);
         r.faces_unpinched = Pinches::Resolve(all, inSurface);
         r.faces_unsupported = BoundaryTrim::RemoveUnsupported(all, samples, p.min_support, inSurface);
         // A piece smaller than the smallest hole kept, or than a few cells when every hole is

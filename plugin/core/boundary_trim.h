@@ -27,14 +27,28 @@ class BoundaryTrim
 public:
     static constexpr double kOutsideGap = 135 * M_PI / 180;
     static constexpr int kAround = 8;  ///< samples examined around a face
+    /// How far, in its own spacings, a sample across the gap may be; probes reach this many
+    /// times the nearest sample's distance into the gap.
+    static constexpr double kAcross = 2.0;
+    static constexpr double kAcrossProbes = 8.0;
+    /// A sample across the gap counts when it lies within this angle of the gap's middle
+    /// direction (beyond the face, not beside it along the scan's edge) and its spacing is at
+    /// least kSparser times the nearest sample's (a sparser part: where both sides are sampled
+    /// alike, a gap wider than the near side's sampling leaves is a hole).
+    static constexpr double kAcrossAngle = M_PI / 4;
+    static constexpr double kSparser = 3.0;
 
     /// Among the faces f of `mesh` with inSurface[f], removes (sets inSurface[f] = 0) those
     /// reachable from the boundary through unsupported faces. reach: per sample, the largest
     /// supported distance. Needs the mesh's face-face adjacency (vcg UpdateTopology::FaceFace),
     /// built once for the whole extraction: surface membership is read from inSurface.
     /// Returns the number of faces removed.
+    /// `spacing`, when given (per sample, its local spacing), lets a face whose nearest samples
+    /// lie to one side look across the gap: where a sample beyond it lies within kAcross of its
+    /// own spacings, the face is in a gap of that sample's sampling (a sparse part beside a
+    /// dense one), not past the scan's edge, and stays.
     static size_t Compute(const CoreMesh& mesh, const SampleIndex& samples, const Eigen::VectorXd& reach,
-                          std::vector<char>& inSurface, int threads = 0)
+                          std::vector<char>& inSurface, int threads = 0, const Eigen::VectorXd* spacing = nullptr)
     {
         const size_t n = mesh.face.size();
         std::vector<char> far(n, 0);
@@ -49,7 +63,7 @@ public:
             }
         });
         SampleIndex::Queue queue;
-        auto unsupported = [&](size_t f) { return far[f] && SamplesOnOneSide(mesh.face[f], samples, queue); };
+        auto unsupported = [&](size_t f) { return far[f] && SamplesOnOneSide(mesh.face[f], samples, queue, spacing); };
 
         std::deque<int> pending;
         for (size_t f = 0; f < n; ++f)
@@ -141,8 +155,11 @@ private:
     }
 
     /// True when the kAround samples nearest to the face's centroid, projected onto the face's
-    /// plane, leave an angular gap wider than kOutsideGap around it.
-    static bool SamplesOnOneSide(const CoreFace& face, const SampleIndex& samples, SampleIndex::Queue& queue)
+    /// plane, leave an angular gap wider than kOutsideGap around it, and (with `spacing`) no
+    /// sample across that gap is sparser and near enough (see Compute): looked for from points
+    /// pushed into the gap's middle, 1, 2, 4, 8 times the nearest sample's distance.
+    static bool SamplesOnOneSide(const CoreFace& face, const SampleIndex& samples, SampleIndex::Queue& queue,
+                                 const Eigen::VectorXd* spacing = nullptr)
     {
         const vcg::Point3d bc = vcg::Barycenter(face), nn = vcg::TriangleNormal(face);
         const Eigen::Vector3d c(bc[0], bc[1], bc[2]);
@@ -152,19 +169,46 @@ private:
         n.normalize();
         const Eigen::Vector3d u = n.unitOrthogonal(), v = n.cross(u);
         samples.Nearest(c, kAround, queue);
-        std::array<double, kAround> angle;
         // The query returns at most kAround; saying so lets GCC 12 see that std::sort stays
         // inside `angle` (-Warray-bounds otherwise follows its path for more than 16 elements).
-        const int found = std::clamp(queue.getNofElements(), 0, kAround);
-        for (int i = 0; i < found; ++i) {
+        const int near = std::clamp(queue.getNofElements(), 0, kAround);
+        if (near == 0)
+            return true;
+        std::array<double, kAround> angle;
+        int closest = 0;  // the queue's slot of the nearest sample
+        for (int i = 0; i < near; ++i) {
             const Eigen::Vector3d d = samples.P().row(queue.getIndex(i)).transpose() - c;
             angle[size_t(i)] = std::atan2(d.dot(v), d.dot(u));
+            if (queue.getWeight(i) < queue.getWeight(closest))
+                closest = i;
         }
-        std::sort(angle.begin(), angle.begin() + found);
-        double gap = found > 0 ? angle[0] + 2 * M_PI - angle[size_t(found - 1)] : 2 * M_PI;
-        for (int i = 1; i < found; ++i)
-            gap = std::max(gap, angle[size_t(i)] - angle[size_t(i - 1)]);
-        return gap > kOutsideGap;
+        std::sort(angle.begin(), angle.begin() + near);
+        double gap = angle[0] + 2 * M_PI - angle[size_t(near - 1)], from = angle[size_t(near - 1)];
+        for (int i = 1; i < near; ++i)
+            if (angle[size_t(i)] - angle[size_t(i - 1)] > gap) {
+                gap = angle[size_t(i)] - angle[size_t(i - 1)];
+                from = angle[size_t(i - 1)];
+            }
+        if (gap <= kOutsideGap)
+            return false;
+        if (!spacing)
+            return true;
+        // Look across: probe points pushed from the centroid into the gap, farther each time.
+        const double nearSpacing = (*spacing)[queue.getIndex(closest)];
+        const double nearest = std::sqrt(queue.getWeight(closest));
+        const double middle = from + gap / 2;
+        const Eigen::Vector3d m = std::cos(middle) * u + std::sin(middle) * v;
+        SampleIndex::Queue across;
+        for (double t = nearest; t <= kAcrossProbes * nearest; t *= 2) {
+            samples.Nearest(c + t * m, 1, across);
+            const Eigen::Index j = across.getIndex(0);
+            const Eigen::Vector3d d = samples.P().row(j).transpose() - c;
+            const double own = (*spacing)[j];
+            if (own >= kSparser * nearSpacing && d.norm() <= kAcross * own &&
+                std::abs(std::remainder(std::atan2(d.dot(v), d.dot(u)) - middle, 2 * M_PI)) < kAcrossAngle)
+                return false;
+        }
+        return true;
     }
 
     /// The surface face across edge i of face f, or -1 (a border, or a face not in the surface).

@@ -2,6 +2,7 @@
 // supported by too few samples removed.
 #include "boundary_trim.h"
 #include "geometry.h"
+#include "spacing.h"
 
 #include <gtest/gtest.h>
 
@@ -109,4 +110,43 @@ TEST(BoundaryTrim, PiecesWithTooFewNearestSamplesAreRemoved)
     EXPECT_EQ(inSurface.back(), 0);
     EXPECT_EQ(std::count(inSurface.begin(), inSurface.end(), 1), 32);
     EXPECT_EQ(BoundaryTrim::RemoveUnsupported(m, samples, 26, inSurface), 32u);  // 25 distinct at most
+}
+
+TEST(BoundaryTrim, AGapBesideASparserPartIsNoEdge)
+{
+    // Samples 0.02 apart left of x = 0.5 and 0.1 apart (5 times sparser) right of x = 0.62: the
+    // faces in the gap next to the dense part have only dense samples among their nearest, all
+    // to one side. Looking across the gap they find the sparse samples within 2 of their
+    // spacings and stay; without the spacings they are peeled from the border in. With the
+    // sparse part gone, the faces past the dense part's edge go either way.
+    CoreMesh m;
+    test::Grid(25, 0.04, m);
+    const Points dense = HalfScan(0.02, 0.5);
+    Points P = dense;
+    for (int j = 0; j <= 10; ++j)
+        for (int i = 0; 0.62 + 0.1 * i <= 1 + 1e-9; ++i) {
+            P.conservativeResize(P.rows() + 1, 3);
+            P.row(P.rows() - 1) << 0.62 + 0.1 * i, 0.1 * j, 0;
+        }
+    const SampleIndex samples(P);
+    const Eigen::VectorXd spacing = SampleSpacing::Local(samples);
+    auto besideDense = [&](const std::vector<char>& inSurface) {  // the cells over 0.52 < x < 0.56, inside rows
+        int kept = 0;
+        for (size_t f = 0; f < m.face.size(); ++f) {
+            const vcg::Point3d c = vcg::Barycenter(m.face[f]);
+            kept += inSurface[f] && c[0] > 0.52 && c[0] < 0.56 && c[1] > 0.04 && c[1] < 0.96;
+        }
+        return kept;
+    };
+    std::vector<char> across(m.face.size(), 1), blind(m.face.size(), 1);
+    BoundaryTrim::Compute(m, samples, Eigen::VectorXd(0.25 * spacing), across, 1, &spacing);
+    BoundaryTrim::Compute(m, samples, Eigen::VectorXd(0.25 * spacing), blind, 1);
+    EXPECT_EQ(besideDense(across), 23 * 2);
+    EXPECT_EQ(besideDense(blind), 0);
+
+    const SampleIndex alone(dense);
+    const Eigen::VectorXd own = SampleSpacing::Local(alone);
+    std::vector<char> edge(m.face.size(), 1);
+    BoundaryTrim::Compute(m, alone, Eigen::VectorXd(0.25 * own), edge, 1, &own);
+    EXPECT_EQ(besideDense(edge), 0);
 }
