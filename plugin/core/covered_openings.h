@@ -9,11 +9,15 @@
 /// where no point of it is farther from a sample than the surface around the loop already is
 /// (its faces within kBand spacings), or than kReach median spacings, the patch is as well
 /// supported as the surface it closes, and the loop is closed by VCGlib's ear-cutting hole
-/// filler (vcg/complex/algorithms/hole.h, with its minimum-weight ears). The fan of a loop that bounds its piece from outside (the rim of a
-/// flat scan) lies on the piece itself, among samples: a loop whose fan is not smaller than
-/// half its piece is no opening.
+/// filler (vcg/complex/algorithms/hole.h, with its minimum-weight ears). The fan of a loop
+/// that bounds its piece from outside (the rim of a flat scan) lies on the piece itself, among
+/// samples: a loop whose fan is not smaller than half its piece is no opening.
+/// When the input is a mesh, its triangles say where its holes are, more surely than the
+/// samples' spacing: an opening whose fan lies over the triangles is closed (OverTriangles).
 
 #include "boundaries.h"
+#include "implicit/mesh_distance.h"
+#include "mesh_holes.h"
 #include "mesh.h"
 #include "samples.h"
 
@@ -83,56 +87,34 @@ public:
     static Result Compute(CoreMesh& mesh, const SampleIndex& samples, double spacing,
                           const Eigen::VectorXd* local = nullptr)
     {
-        Result r;
-        if (!(spacing > 0) || mesh.face.empty())
-            return r;
-        const std::vector<BoundaryLoop> loops = BoundaryLoops::Compute(mesh);
-        if (loops.empty())
-            return r;
-        const std::vector<int> uses = BoundaryLoops::Uses(mesh, loops);
-        std::vector<double> pieceArea;
-        const std::vector<int> piece = Pieces(mesh, pieceArea);
-        std::vector<int> faceOfVertex(mesh.vert.size(), -1);
-        for (size_t f = 0; f < mesh.face.size(); ++f)
-            for (int i = 0; i < 3; ++i)
-                faceOfVertex[vcg::tri::Index(mesh, mesh.face[f].cV(i))] = int(f);
-
-        std::vector<const BoundaryLoop*> close;
-        for (const BoundaryLoop& loop : loops) {
-            bool simple = loop.Edges() >= 3;
-            for (int v : loop.vertices)
-                simple = simple && uses[size_t(v)] == 1;
-            if (!simple)
-                continue;
-            const double area = pieceArea[size_t(piece[size_t(faceOfVertex[size_t(loop.vertices[0])])])];
-            if (FanArea(mesh, loop) >= kOutsideFan * area)
-                continue;
+        if (!(spacing > 0))
+            return Result();
+        return CloseWhere(mesh, [&](const BoundaryLoop& loop, const std::vector<int>& faceOfVertex) {
             const double band = kBand * std::max(spacing, local ? SpacingAt(mesh, loop, samples, *local) : 0.0);
             const double limit =
                 std::max(kReach, SurfaceGap(mesh, loop, faceOfVertex, samples, band, kProbeStep * spacing) / spacing);
-            const double reach = Reach(mesh, loop, samples, spacing, limit) / spacing;
-            if (reach <= limit)
-                close.push_back(&loop);
-            else if (r.closest_kept == 0 || reach / limit < r.closest_kept)
-                r.closest_kept = reach / limit;
-        }
-        if (close.empty())
-            return r;
-        // The loops are apart (no shared vertex), so one's new faces touch no other's ring.
-        Around around;
-        for (const BoundaryLoop* loop : close)
-            for (int v : loop->vertices)
-                around[v];
-        for (size_t f = 0; f < mesh.face.size(); ++f)
-            for (int i = 0; i < 3; ++i) {
-                const auto it = around.find(int(vcg::tri::Index(mesh, mesh.face[f].cV(i))));
-                if (it != around.end())
-                    it->second.push_back(f);
-            }
-        for (const BoundaryLoop* loop : close)
-            r.closed += int(Fill(mesh, *loop, around));
-        UpdateFaceFace(mesh);
-        return r;
+            return Reach(mesh, loop, samples, spacing, limit) / spacing / limit;
+        });
+    }
+
+    /// The same for a surface made from a mesh (`input`, its triangles; `cellSize`, the
+    /// lattice's): an opening whose fan lies over the triangles everywhere (MeshHoles: at most
+    /// kPastBorderCells cells past their border) is no hole of the mesh, and is closed. A
+    /// hole of the mesh leaves its fan past the border.
+    static Result OverTriangles(CoreMesh& mesh, const MeshDistance& input, double cellSize)
+    {
+        if (!(cellSize > 0))
+            return Result();
+        const double allowed = MeshHoles::kPastBorderCells * cellSize;
+        return CloseWhere(mesh, [&](const BoundaryLoop& loop, const std::vector<int>&) {
+            // In batches, the centroid first: over a hole of the mesh it is past the border by
+            // the most, so most holes are told at once.
+            const Points fan = FanPoints(mesh, loop, 0.5 * cellSize);
+            double past = 0;
+            for (Eigen::Index at = 0, batch = 1; at < fan.rows() && past <= allowed; at += batch, batch = 256)
+                past = std::max(past, input.PastBorder(fan.middleRows(at, std::min(batch, fan.rows() - at))).maxCoeff());
+            return past / allowed;
+        });
     }
 
     /// How far the fan from the centroid of `loop` (vertices of `mesh`) to its edges gets from
@@ -191,6 +173,82 @@ public:
     }
 
 private:
+    /// Closes the simple loops of `mesh` that do not bound their piece from outside and whose
+    /// `excess(loop, faceOfVertex)` (how far the fan gets from the support, over what is
+    /// allowed) is at most 1; Result::closest_kept is the smallest excess above 1.
+    template <class Excess>
+    static Result CloseWhere(CoreMesh& mesh, Excess excess)
+    {
+        Result r;
+        if (mesh.face.empty())
+            return r;
+        const std::vector<BoundaryLoop> loops = BoundaryLoops::Compute(mesh);
+        if (loops.empty())
+            return r;
+        const std::vector<int> uses = BoundaryLoops::Uses(mesh, loops);
+        std::vector<double> pieceArea;
+        const std::vector<int> piece = Pieces(mesh, pieceArea);
+        std::vector<int> faceOfVertex(mesh.vert.size(), -1);
+        for (size_t f = 0; f < mesh.face.size(); ++f)
+            for (int i = 0; i < 3; ++i)
+                faceOfVertex[vcg::tri::Index(mesh, mesh.face[f].cV(i))] = int(f);
+
+        std::vector<const BoundaryLoop*> close;
+        for (const BoundaryLoop& loop : loops) {
+            bool simple = loop.Edges() >= 3;
+            for (int v : loop.vertices)
+                simple = simple && uses[size_t(v)] == 1;
+            if (!simple)
+                continue;
+            const double area = pieceArea[size_t(piece[size_t(faceOfVertex[size_t(loop.vertices[0])])])];
+            if (FanArea(mesh, loop) >= kOutsideFan * area)
+                continue;
+            const double e = excess(loop, faceOfVertex);
+            if (e <= 1)
+                close.push_back(&loop);
+            else if (r.closest_kept == 0 || e < r.closest_kept)
+                r.closest_kept = e;
+        }
+        if (close.empty())
+            return r;
+        // The loops are apart (no shared vertex), so one's new faces touch no other's ring.
+        Around around;
+        for (const BoundaryLoop* loop : close)
+            for (int v : loop->vertices)
+                around[v];
+        for (size_t f = 0; f < mesh.face.size(); ++f)
+            for (int i = 0; i < 3; ++i) {
+                const auto it = around.find(int(vcg::tri::Index(mesh, mesh.face[f].cV(i))));
+                if (it != around.end())
+                    it->second.push_back(f);
+            }
+        for (const BoundaryLoop* loop : close)
+            r.closed += int(Fill(mesh, *loop, around));
+        UpdateFaceFace(mesh);
+        return r;
+    }
+
+    /// Points of the fan from the centroid of `loop` to its edges, a barycentric grid at most
+    /// `step` apart in each fan triangle.
+    static Points FanPoints(const CoreMesh& mesh, const BoundaryLoop& loop, double step)
+    {
+        const Eigen::Vector3d c = Centroid(mesh, loop);
+        std::vector<Eigen::Vector3d> points{c};
+        const size_t n = loop.vertices.size();
+        for (size_t i = 0; i < n; ++i) {
+            const Eigen::Vector3d a = PositionOf(mesh, loop.vertices[i]), b = PositionOf(mesh, loop.vertices[(i + 1) % n]);
+            const int steps = std::max(1, int(std::ceil(std::max({(a - c).norm(), (b - c).norm(), (b - a).norm()}) / step)));
+            for (int u = 0; u <= steps; ++u)
+                for (int w = 0; u + w <= steps; ++w)
+                    if (u + w > 0)
+                        points.push_back(c + (a - c) * (double(u) / steps) + (b - c) * (double(w) / steps));
+        }
+        Points P(Eigen::Index(points.size()), 3);
+        for (size_t k = 0; k < points.size(); ++k)
+            P.row(Eigen::Index(k)) = points[k].transpose();
+        return P;
+    }
+
     /// The median of the `local` spacings of the samples nearest to the vertices of `loop`.
     static double SpacingAt(const CoreMesh& mesh, const BoundaryLoop& loop, const SampleIndex& samples,
                             const Eigen::VectorXd& local)

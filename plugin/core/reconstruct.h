@@ -231,11 +231,12 @@ private:
         if (holes)
             BoundaryStage::SplitHoles(surface, inSurface, *holes);
         BoundaryStage::KeepSurface(surface, inSurface);
-        // On the whole surface, before a tile's clip: the halo sees a seam's openings whole.
-        // A mesh's triangles already say where its holes are (mesh_holes.h), and a
-        // min_boundary_edges of 0 keeps every opening.
-        if (!triangles && p.min_boundary_edges > 0 && p.extraction != GatedMarchingCubes::Extraction::Plain)
-            r.openings = CoveredOpenings::Compute(surface, samples, r.sample_spacing, &spacing);
+        // On the whole surface, before a tile's clip: the halo sees a seam's openings whole. A
+        // mesh's triangles say where its holes are (mesh_holes.h): an opening over them is
+        // none. A min_boundary_edges of 0 keeps every opening.
+        if (p.min_boundary_edges > 0 && p.extraction != GatedMarchingCubes::Extraction::Plain)
+            r.openings = triangles ? CoveredOpenings::OverTriangles(surface, *triangles, r.cell_size)
+                                   : CoveredOpenings::Compute(surface, samples, r.sample_spacing, &spacing);
         p.tile.Clip(surface);
         if (holes)
             p.tile.Clip(*holes);

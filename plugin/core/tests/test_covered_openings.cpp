@@ -115,3 +115,28 @@ TEST(CoveredOpenings, AnOpeningNoFartherFromTheSamplesThanTheSurfaceAroundIsClos
         EXPECT_EQ(BoundaryLoops::Compute(m).size(), hole < 2 ? 1u : 2u) << hole;
     }
 }
+
+TEST(CoveredOpenings, OverTheInputTrianglesAnOpeningIsClosedAndAHoleOfTheMeshKept)
+{
+    // The surface a grid with an opening of radius 3 cut out; the input mesh the same grid,
+    // whole or with the same hole: the opening is closed only over whole triangles.
+    for (const bool inputHoled : {false, true}) {
+        CoreMesh input;
+        test::Grid(20, 1.0, input);
+        if (inputHoled)
+            CutOut(input, vcg::Point3d(10, 10, 0), 3.0);
+        Faces F(Eigen::Index(input.face.size()), 3);
+        for (size_t f = 0; f < input.face.size(); ++f)
+            for (int i = 0; i < 3; ++i)
+                F(Eigen::Index(f), i) = int(vcg::tri::Index(input, input.face[f].cV(i)));
+        const MeshDistance triangles(VerticesOf(input), F);
+        CoreMesh m;
+        test::Grid(20, 1.0, m);
+        CutOut(m, vcg::Point3d(10, 10, 0), 3.0);
+        const CoveredOpenings::Result r = CoveredOpenings::OverTriangles(m, triangles, 0.5);
+        EXPECT_EQ(r.closed, inputHoled ? 0 : 1) << inputHoled;
+        EXPECT_EQ(BoundaryLoops::Compute(m).size(), inputHoled ? 2u : 1u) << inputHoled;
+        if (inputHoled)
+            EXPECT_GT(r.closest_kept, 4.0);  // the centroid ~6 cells past the input's border, 0.5 allowed
+    }
+}
