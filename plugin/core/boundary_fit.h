@@ -5,13 +5,17 @@
 /// somewhere between that reach and a face past the last samples, while a scan's real edge is
 /// its outermost samples. For each boundary vertex v, with n the surface normal there, o is
 /// the direction in the tangent plane away from the centroid of the samples around v (out of
-/// the surface; it must agree with the loop's orientation). Among those samples that lie
+/// the surface; where it disagrees with the loop's orientation, as in a notch of the trimmed
+/// loop with a dense row of samples along the edge past it, the loop's own direction over a
+/// few vertices each way). Among those samples that lie
 /// beside v (within a local spacing across o and off the surface), the upper hull of their
 /// positions along o marks the edge at v; v moves along o onto it (plus
 /// `offset` local spacings), by at most `max_move` spacings, and the vertices next to v follow
-/// (FollowMoves). All targets are computed before any vertex moves. The moved vertices are put
-/// back on the implicit surface (the move is along its tangent plane, implicit_projection.h),
-/// then moves that would fold a face are pulled back (fold_guard.h).
+/// (FollowMoves); where samples lie within a spacing of a point 1.5 spacings past the edge,
+/// they go on there (a cut at an orientation seam) and v stays. All targets are computed
+/// before any vertex moves. The moved vertices are put back on the implicit surface (the move
+/// is along its tangent plane, implicit_projection.h), then moves that would fold a face of
+/// the surface are pulled back (fold_guard.h).
 
 #include "boundaries.h"
 #include "fold_guard.h"
@@ -29,6 +33,12 @@ namespace ib {
 class BoundaryFit
 {
 public:
+    /// Loop vertices each way over which the loop's direction is taken where the samples'
+    /// centroid does not tell the side (a notch of the trimmed boundary).
+    static constexpr size_t kStencil = 3;
+    /// How far past the edge, in local spacings, a vertex looks for samples going on.
+    static constexpr double kBeyond = 1.5;
+
     struct Param
     {
         double offset = 0.0;    ///< boundary beyond the outermost samples, in local spacings
@@ -52,7 +62,7 @@ public:
         std::vector<int> moved;
         std::vector<Eigen::Vector3d> start, target;
         std::vector<Eigen::Vector2d> beside;  // (along t, along out) of the samples beside a vertex
-        SampleIndex::Queue queue;
+        SampleIndex::Queue queue, probe;
         for (const auto& loop : loops) {
             const size_t count = loop.vertices.size();
             for (size_t i = 0; i < count && count >= 3; ++i) {
@@ -73,8 +83,19 @@ public:
                     centroid += samples.P().row(queue.getIndex(k)).transpose();
                 Eigen::Vector3d out = q - centroid / std::max(found, 1);
                 out = (out - out.dot(n) * n).normalized();
-                if (!out.allFinite() || out.dot(along.cross(n)) <= 0)
-                    continue;  // no clear side (a corner, a narrow strip): leave the vertex
+                if (!out.allFinite() || out.dot(along.cross(n)) <= 0) {
+                    // The samples' centroid lies beyond v: v sits in a notch of the loop, a
+                    // dense row of samples along the edge outside it (a cut), or the samples
+                    // go on past it (an orientation seam's cut). The loop's direction over
+                    // kStencil vertices each way, past the notch's own turns, says where out
+                    // is; whether the samples end there is asked below, as for every vertex.
+                    const Eigen::Vector3d wide = PositionOf(mesh, loop.vertices[(i + kStencil) % count]) -
+                                                 PositionOf(mesh, loop.vertices[(i + count - kStencil % count) % count]);
+                    out = wide.cross(n);
+                    out = (out - out.dot(n) * n).normalized();
+                    if (!out.allFinite())
+                        continue;
+                }
                 const Eigen::Vector3d t = n.cross(out);
                 // The edge at v: the upper hull, over a (along t) and o (along out), of the
                 // samples beside v (within a spacing along t and off the surface), at a = 0:
@@ -108,6 +129,12 @@ public:
                         edge = std::max(edge, b[1]);
                 if (!(h > 0) || edge == none)
                     continue;
+                // The samples end at an edge: no sample within a spacing of a point kBeyond
+                // spacings past it. Where they go on (an orientation seam's cut, whose faces
+                // are gone), there is no edge to move to.
+                samples.Nearest(q + (edge + kBeyond * h) * out, 1, probe);
+                if (probe.getNofElements() == 0 || probe.getWeight(0) < h * h)
+                    continue;
                 const double step = std::clamp(edge + p.offset * h, -p.max_move * h, p.max_move * h);
                 moved.push_back(v);
                 start.push_back(q);
@@ -120,7 +147,9 @@ public:
         FollowMoves(mesh, uses, p.ring_steps, moved, start);
         if (f && p.newton_steps > 0 && p.cell_size > 0)
             ImplicitProjection::Compute(mesh, moved, *f, p.newton_steps, p.cell_size);
-        FoldGuard::Restore(mesh, moved, start);
+        // Only the surface's faces count: the trimmed ones outside it may fold (counting them
+        // held a notch's vertex back from the edge).
+        FoldGuard::Restore(mesh, moved, start, &inSurface);
         return fitted;
     }
 

@@ -111,3 +111,48 @@ TEST(BoundaryFit, MovesAtMostMaxMoveSpacings)
     EXPECT_GT(longest, 0.49 * kSpacing);
     EXPECT_EQ(r.count, r.loops[0].vertices.size());
 }
+
+TEST(BoundaryFit, ANotchedBoundaryReachesADenseRowOfEdgeSamples)
+{
+    // A plane cut's edge: the flat scan's samples plus a row 4 times denser along x = 1. The
+    // trimmed surface reaches it in teeth: notches up to 1.2 spacings deep, 0.1 apart. The
+    // dense row pulls the samples' centroid past a notch's vertex (its side is then told by
+    // the loop over a few vertices). Left where it was before (a spacing off the edge); now
+    // moved towards it as far as the tooth's faces beside it let it go without folding.
+    Points flat, N;
+    test::FlatScan(kSpacing, flat, N);
+    const int row = 201;
+    Points P(flat.rows() + row, 3);
+    P.topRows(flat.rows()) = flat;
+    for (int k = 0; k < row; ++k)
+        P.row(flat.rows() + k) << 1.0, k * 0.005, 0.0;
+    const SampleIndex samples(P);
+    CoreMesh m;
+    test::Grid(50, 0.02, m);
+    for (CoreFace& f : m.face) {
+        const vcg::Point3d c = vcg::Barycenter(f);
+        const double tooth = std::abs(std::fmod(c[1], 0.1) / 0.05 - 1);  // 1 at a notch, 0 at a tip
+        if (c[0] > 1 - 1.2 * kSpacing * tooth)
+            vcg::tri::Allocator<CoreMesh>::DeleteFace(m, f);
+    }
+    vcg::tri::Clean<CoreMesh>::RemoveUnreferencedVertex(m);
+    vcg::tri::Allocator<CoreMesh>::CompactEveryVector(m);
+    vcg::tri::UpdateTopology<CoreMesh>::FaceFace(m);
+    const std::vector<char> inSurface(m.face.size(), 1);
+    const std::vector<BoundaryLoop> loops = BoundaryLoops::Compute(m, inSurface);
+    ASSERT_EQ(loops.size(), 1u);
+    auto deepest = [&] {  // the right side's loop vertex farthest from x = 1, corners left out
+        double d = 0;
+        for (int v : loops[0].vertices)
+            if (const vcg::Point3d& q = m.vert[size_t(v)].cP(); q[0] > 0.9 && q[1] > 0.1 && q[1] < 0.9)
+                d = std::max(d, 1 - q[0]);
+        return d;
+    };
+    ASSERT_GT(deepest(), 1.0 * kSpacing);
+    BoundaryFit::Compute(m, loops, inSurface, samples, Eigen::VectorXd::Constant(P.rows(), kSpacing), nullptr,
+                         BoundaryFit::Param());
+    EXPECT_LT(deepest(), 0.6 * kSpacing);
+    const auto t = test::Check(m);
+    EXPECT_TRUE(t.oriented);
+    EXPECT_EQ(t.non_manifold_edges, 0);
+}
