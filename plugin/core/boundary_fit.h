@@ -14,8 +14,9 @@
 /// (FollowMoves); where samples lie within a spacing of a point 1.5 spacings past the edge,
 /// they go on there (a cut at an orientation seam) and v stays. All targets are computed
 /// before any vertex moves. The moved vertices are put back on the implicit surface (the move
-/// is along its tangent plane, implicit_projection.h), then moves that would fold a face of
-/// the surface are pulled back (fold_guard.h).
+/// is along its tangent plane, implicit_projection.h), then moves that would fold a face are
+/// pulled back (fold_guard.h; the faces out of the surface count too: with the hole layer they
+/// close the surface).
 
 #include "boundaries.h"
 #include "fold_guard.h"
@@ -147,9 +148,7 @@ public:
         FollowMoves(mesh, uses, p.ring_steps, moved, start);
         if (f && p.newton_steps > 0 && p.cell_size > 0)
             ImplicitProjection::Compute(mesh, moved, *f, p.newton_steps, p.cell_size);
-        // Only the surface's faces count: the trimmed ones outside it may fold (counting them
-        // held a notch's vertex back from the edge).
-        FoldGuard::Restore(mesh, moved, start, &inSurface);
+        FoldGuard::Restore(mesh, moved, start);
         return fitted;
     }
 

@@ -18,17 +18,15 @@ class FoldGuard
 public:
     /// `moved`: vertex indices of `mesh` already at their new positions; `start`: their
     /// positions before the move (same order). Pulls back the moves that flip a face.
-    /// counted: per face of `mesh`, whether it counts (null: all).
     /// Returns the number of vertices not left at their new position.
-    static size_t Restore(CoreMesh& mesh, const std::vector<int>& moved, const std::vector<Eigen::Vector3d>& start,
-                          const std::vector<char>* counted = nullptr)
+    static size_t Restore(CoreMesh& mesh, const std::vector<int>& moved, const std::vector<Eigen::Vector3d>& start)
     {
         std::vector<int> slot(mesh.vert.size(), -1);
         for (size_t i = 0; i < moved.size(); ++i)
             slot[size_t(moved[i])] = int(i);
         std::vector<std::vector<int>> faces(moved.size());
         for (size_t f = 0; f < mesh.face.size(); ++f)
-            for (int i = 0; i < 3 && (!counted || (*counted)[f]); ++i)
+            for (int i = 0; i < 3; ++i)
                 if (const int s = slot[vcg::tri::Index(mesh, mesh.face[f].cV(i))]; s >= 0)
                     faces[size_t(s)].push_back(int(f));
         std::vector<Eigen::Vector3d> target(moved.size());
