@@ -136,7 +136,8 @@ TEST(CoveredOpenings, OverTheInputTrianglesAnOpeningIsClosedAndAHoleOfTheMeshKep
         const CoveredOpenings::Result r = CoveredOpenings::OverTriangles(m, triangles, 0.5);
         EXPECT_EQ(r.closed, inputHoled ? 0 : 1) << inputHoled;
         EXPECT_EQ(BoundaryLoops::Compute(m).size(), inputHoled ? 2u : 1u) << inputHoled;
-        if (inputHoled)
+        if (inputHoled) {
             EXPECT_GT(r.closest_kept, 4.0);  // the centroid ~6 cells past the input's border, 0.5 allowed
+        }
     }
 }
