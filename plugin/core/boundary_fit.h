@@ -92,8 +92,7 @@ public:
                     // is; whether the samples end there is asked below, as for every vertex.
                     const Eigen::Vector3d wide = PositionOf(mesh, loop.vertices[(i + kStencil) % count]) -
                                                  PositionOf(mesh, loop.vertices[(i + count - kStencil % count) % count]);
-                    out = wide.cross(n);
-                    out = (out - out.dot(n) * n).normalized();
+                    out = wide.cross(n).normalized();
                     if (!out.allFinite())
                         continue;
                 }
