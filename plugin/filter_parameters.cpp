@@ -150,7 +150,8 @@ RichParameterList FilterImplicitBoundariesPlugin::reconstructionParameters(const
 		"A hole whose boundary loop has fewer edges is taken as undersampling and filled with "
 		"its hole triangles (the implicit surface across it); larger holes are kept as real "
 		"boundaries. 0 keeps every hole. Raise it to fill more gaps of a sparse scan; lower it "
-		"to keep small real holes. Counts grow with the resolution."));
+		"to keep small real holes. Counts grow with the resolution; among samples k times sparser "
+		"than the median a loop may have k times as many edges (gaps grow with the spacing)."));
 	par.addParam(RichInt(
 		"boundary_smoothing", d.boundary_smoothing, "Boundary smoothing (iterations)",
 		"Passes of the paper's collinearity moves along each boundary loop, after which the "

@@ -152,6 +152,19 @@ def test_a_scan_sparser_on_one_half_keeps_only_its_rim(ratio):
     assert np.abs(np.linalg.norm(rec.vertices, axis=1) - 1).max() < 0.01
 
 
+def test_a_scan_thinning_out_smoothly_keeps_only_its_rim():
+    """A hemisphere whose random samples thin out smoothly to 10 times the spacing (an adaptive
+    decimation): one loop, the rim. Among the sparse samples the random gaps leave openings of
+    a few sparse spacings, many lattice edges long; counted in edges at the median spacing they
+    were taken for holes and the trim peeled one to 799 edges (2 loops). A loop is now counted
+    in the edges of its own sampling."""
+    points, normals = shapes.uneven_hemisphere(10, smooth=True)
+    rec = implicit_boundaries.reconstruct(points, normals)
+    assert len(rec.loops) == 1
+    assert np.median(rec.vertices[rec.loops[0]][:, 2]) < 0.05  # the rim, at z = 0
+    assert rec.info["holes_filled"] > 0
+
+
 @pytest.mark.parametrize("noise", [0.0, 0.002])
 @pytest.mark.parametrize("given_normals", [True, False], ids=["given normals", "estimated normals"])
 def test_a_terrain_keeps_its_border_and_its_pond(noise, given_normals):

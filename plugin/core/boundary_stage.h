@@ -47,13 +47,19 @@ public:
     /// walls a signed implicit function forms where the normals flip reach about 1.75 spacings
     /// to either side (Möbius strip, both implicit functions).
     static constexpr double kSeamRadius = 2.0;
+    /// A sample at a hole's rim has its neighbours on one side only, so its local spacing reads
+    /// up to sqrt(2) times too wide (half the disk holds its k neighbours): measured at the loops
+    /// of uniformly sampled scans (bun_zipper, a terrain with holes cut into it), 1.2 to 1.6
+    /// times the median. A loop's local spacing counts for its size only beyond that.
+    static constexpr double kRimSpacing = M_SQRT2;
     /// Pieces of surface with fewer faces left by the trim are removed (a few cells' worth).
     static constexpr size_t kMinPieceFaces = 10;
 
     struct Param
     {
         /// Holes whose loops all have fewer edges are undersampling: their hole triangles are
-        /// added to the surface (paper §3.1). 0 keeps every hole.
+        /// added to the surface (paper §3.1). Counted at the median spacing: a loop among
+        /// samples k times sparser may have k times as many. 0 keeps every hole.
         int min_boundary_edges = kDefaultMinBoundaryEdges;
         /// Faces at the boundary farther than this many local spacings from every sample are
         /// peeled off (the margin the SODS adds past the scan's edge). 0 = no trim.
@@ -79,8 +85,9 @@ public:
     {
         std::vector<int> loops_before_filling;  ///< edge counts of all loops before small holes were filled
         int holes_filled = 0;             ///< hole regions added to the surface
-        /// How close the size decisions were (edges of a hole's longest loop, before filling; 0:
-        /// no such hole): the largest hole filled as undersampling, and the smallest hole the
+        /// How close the size decisions were (edges of a hole's longest loop, before filling,
+        /// counted at the median spacing, rounded down (see SmallHoles); 0: no such hole): the
+        /// largest hole filled as undersampling, and the smallest hole the
         /// implicit surface closes that was kept open. A min_boundary_edges above the second
         /// fills it too; one at or below the first keeps that one open.
         int largest_hole_filled = 0;
@@ -113,7 +120,8 @@ public:
         // gap between the scans' coverage, filled whatever its loops' size.
         const std::vector<int> fill = SmallHoles(all, inSurface, mc, p.min_boundary_edges,
                                                  p.merged_scans ? &samples : nullptr, spacing, p.threads,
-                                                 r.loops_before_filling, &r, p.input_mesh, p.cell_size);
+                                                 r.loops_before_filling, &r, p.input_mesh, p.cell_size,
+                                                 &samples, p.sample_spacing);
         for (size_t face = mc.surface_faces; face < all.face.size(); ++face)
             if (fill[size_t(mc.face_region[face - mc.surface_faces])])
                 inSurface[face] = 1;
@@ -152,7 +160,12 @@ public:
     /// balloon (at most kPatchFacesPerSquaredEdge × (its loops' edges)² faces: a flat patch
     /// inside a loop of L edges has about L² / 2π of them; where the implicit surface closes a
     /// gap by a detour far from every sample, a torn tip whose fit bulges away, many more), and
-    /// small: every loop along it has fewer than `min_edges` edges, or, with `coverage` (the
+    /// small: every loop along it has fewer than `min_edges` edges, or, with `local` (the
+    /// samples, `spacing` theirs, `medianSpacing` its median), fewer than `min_edges` times the
+    /// local spacing around the loop (LocalSpacing) over kRimSpacing medians, when above 1: the
+    /// gaps a sampling leaves grow with its spacing, and where the samples thin out smoothly
+    /// (an adaptive decimation) random gaps of a few sparse spacings opened as loops of 18
+    /// edges, which the trim then peeled open. Or, with `coverage` (the
     /// samples of merged scans, their local `spacing`; null: no such rule), none of it is
     /// farther than kCoverageGap spacings from them, or, with `mesh` (the input's triangles;
     /// null: none), all of it lies over them (MeshHoles::Covered, on a lattice of `cellSize`).
@@ -162,7 +175,8 @@ public:
                                        const GatedMarchingCubes::Result& mc, int min_edges,
                                        const SampleIndex* coverage, const Eigen::VectorXd& spacing, int threads,
                                        std::vector<int>& loopEdges, Result* margins = nullptr,
-                                       const MeshDistance* mesh = nullptr, double cellSize = 0)
+                                       const MeshDistance* mesh = nullptr, double cellSize = 0,
+                                       const SampleIndex* local = nullptr, double medianSpacing = 0)
     {
         std::vector<int> fill(mc.region_closed.begin(), mc.region_closed.end());
         std::vector<double> edges(fill.size(), 0), faces(fill.size(), 0), longest(fill.size(), 0);
@@ -171,6 +185,9 @@ public:
             ++faces[size_t(region)];
         for (const BoundaryLoop& loop : BoundaryLoops::Compute(all, inSurface)) {
             loopEdges.push_back(loop.Edges());
+            const double scale = local && medianSpacing > 0
+                                     ? std::max(1.0, LocalSpacing(all, loop, *local, spacing) / (kRimSpacing * medianSpacing))
+                                     : 1.0;
             std::vector<size_t> regions;
             for (int face : loop.across)
                 if (face >= 0)  // else a boundary of the whole closed surface (the lattice border)
@@ -179,8 +196,8 @@ public:
             regions.erase(std::unique(regions.begin(), regions.end()), regions.end());
             for (size_t region : regions) {
                 edges[region] += loop.Edges();
-                longest[region] = std::max(longest[region], double(loop.Edges()));
-                large[region] |= char(loop.Edges() >= min_edges);
+                longest[region] = std::max(longest[region], loop.Edges() / scale);
+                large[region] |= char(loop.Edges() >= min_edges * scale);
             }
         }
         std::vector<char> candidate(fill.size(), 0);
@@ -208,6 +225,22 @@ public:
                 margins->smallest_hole_kept = int(longest[i]);
         }
         return fill;
+    }
+
+    /// The median over the vertices of `loop` (of `all`) of the local spacing (`spacing`, per
+    /// sample) of their nearest sample.
+    static double LocalSpacing(const CoreMesh& all, const BoundaryLoop& loop, const SampleIndex& samples,
+                               const Eigen::VectorXd& spacing)
+    {
+        std::vector<double> near;
+        SampleIndex::Queue queue;
+        for (int v : loop.vertices) {
+            const vcg::Point3d& q = all.vert[size_t(v)].cP();
+            samples.Nearest(Eigen::Vector3d(q[0], q[1], q[2]), 1, queue);
+            near.push_back(spacing[queue.getIndex(0)]);
+        }
+        std::nth_element(near.begin(), near.begin() + long(near.size() / 2), near.end());
+        return near[near.size() / 2];
     }
 
     /// Per hole region of `all` (its faces from mc.surface_faces on) with `regions[i]` set, the

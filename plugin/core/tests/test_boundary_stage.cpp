@@ -152,6 +152,48 @@ TEST(BoundaryStage, RegionDepthsAndTheCoverageRule)
     EXPECT_EQ(fill[h.bottom], 0);
 }
 
+TEST(BoundaryStage, ALoopIsCountedInTheEdgesOfItsOwnSampling)
+{
+    TwoHoles h;
+    std::vector<int> edges;
+    BoundaryStage::SmallHoles(h.all, h.inSurface, h.mc, 1000, nullptr, kNoSpacing, 1, edges);
+    const int small = *std::min_element(edges.begin(), edges.end());
+    ASSERT_GE(small, 6);
+    Points all, allNormals;
+    test::SpherePoints(20000, 1.0, all, allNormals, 0.3);
+    std::vector<Eigen::Index> kept;
+    for (Eigen::Index i = 0; i < all.rows(); ++i)
+        if (all.row(i).head<2>().norm() > 0.25)
+            kept.push_back(i);
+    const Points P = all(kept, Eigen::all);
+    const SampleIndex samples(P);
+    // The same loop, too long for min_edges where the samples around it are as dense as the
+    // median (a rim's samples read up to kRimSpacing times wider), is short where they are three
+    // times as far apart beyond that: about a third as many of their spacings.
+    const int minEdges = small / 2 + 1;
+    const double median = 0.1;
+    Eigen::VectorXd rimWide = Eigen::VectorXd::Constant(P.rows(), median), sparseTop = rimWide;
+    for (Eigen::Index i = 0; i < P.rows(); ++i)
+        if (P(i, 2) > 0.9) {
+            rimWide[i] = BoundaryStage::kRimSpacing * median;
+            sparseTop[i] = 3 * BoundaryStage::kRimSpacing * median;
+        }
+    std::vector<int> unused;
+    BoundaryStage::Result margins;
+    std::vector<int> fill = BoundaryStage::SmallHoles(h.all, h.inSurface, h.mc, minEdges, nullptr, rimWide, 1, unused,
+                                                      &margins, nullptr, 0, &samples, median);
+    EXPECT_EQ(fill[h.top], 0);
+    EXPECT_EQ(fill[h.bottom], 0);
+    EXPECT_EQ(margins.smallest_hole_kept, small);
+    margins = BoundaryStage::Result();
+    fill = BoundaryStage::SmallHoles(h.all, h.inSurface, h.mc, minEdges, nullptr, sparseTop, 1, unused, &margins,
+                                     nullptr, 0, &samples, median);
+    EXPECT_EQ(fill[h.top], 1);
+    EXPECT_EQ(fill[h.bottom], 0);
+    // Reported in edges at the median spacing.
+    EXPECT_EQ(margins.largest_hole_filled, small / 3);
+}
+
 TEST(BoundaryStage, SplitAndKeepSurfaceCountFacesAndVertices)
 {
     TwoHoles h;
