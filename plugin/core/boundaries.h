@@ -6,6 +6,7 @@
 /// face, and each loop knows the hole faces across it.
 
 #include "mesh.h"
+#include "samples.h"
 
 #include <algorithm>
 #include <map>
@@ -77,6 +78,21 @@ public:
     }
 
     /// Sum of the edge lengths of `loop` in `mesh`.
+    /// The median, over the vertices of `loop` (of `mesh`), of the local spacing (`spacing`,
+    /// per sample) of their nearest sample: the sampling's scale around the loop.
+    static double SpacingAround(const CoreMesh& mesh, const BoundaryLoop& loop, const SampleIndex& samples,
+                                const Eigen::VectorXd& spacing)
+    {
+        std::vector<double> around;
+        SampleIndex::Queue queue;
+        for (int v : loop.vertices) {
+            samples.Nearest(PositionOf(mesh, v), 1, queue);
+            around.push_back(spacing[Eigen::Index(queue.getIndex(0))]);
+        }
+        std::nth_element(around.begin(), around.begin() + long(around.size() / 2), around.end());
+        return around[around.size() / 2];
+    }
+
     static double Length(const CoreMesh& mesh, const BoundaryLoop& loop)
     {
         double length = 0;

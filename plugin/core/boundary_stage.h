@@ -162,11 +162,11 @@ public:
     /// gap by a detour far from every sample, a torn tip whose fit bulges away, many more), and
     /// small: every loop along it has fewer than `min_edges` edges, or, with `local` (the
     /// samples, `spacing` theirs, `medianSpacing` its median), fewer than `min_edges` times the
-    /// local spacing around the loop (LocalSpacing) over kRimSpacing medians, when above 1: the
-    /// gaps a sampling leaves grow with its spacing, and where the samples thin out smoothly
-    /// (an adaptive decimation) random gaps of a few sparse spacings opened as loops of 18
-    /// edges, which the trim then peeled open. Or, with `coverage` (the
-    /// samples of merged scans, their local `spacing`; null: no such rule), none of it is
+    /// spacing around the loop (BoundaryLoops::SpacingAround) over kRimSpacing medians, when
+    /// above 1: the gaps a sampling leaves grow with its spacing, and where the samples thin
+    /// out smoothly (an adaptive decimation) random gaps of a few sparse spacings opened as
+    /// loops of 18 edges, which the trim then peeled open. Or, with `coverage` (the samples of
+    /// merged scans, their local `spacing`; null: no such rule), none of it is
     /// farther than kCoverageGap spacings from them, or, with `mesh` (the input's triangles;
     /// null: none), all of it lies over them (MeshHoles::Covered, on a lattice of `cellSize`).
     /// Also reports the edge counts of all loops and, in `margins` (may be null),
@@ -185,9 +185,10 @@ public:
             ++faces[size_t(region)];
         for (const BoundaryLoop& loop : BoundaryLoops::Compute(all, inSurface)) {
             loopEdges.push_back(loop.Edges());
-            const double scale = local && medianSpacing > 0
-                                     ? std::max(1.0, LocalSpacing(all, loop, *local, spacing) / (kRimSpacing * medianSpacing))
-                                     : 1.0;
+            const double scale =
+                local && medianSpacing > 0
+                    ? std::max(1.0, BoundaryLoops::SpacingAround(all, loop, *local, spacing) / (kRimSpacing * medianSpacing))
+                    : 1.0;
             std::vector<size_t> regions;
             for (int face : loop.across)
                 if (face >= 0)  // else a boundary of the whole closed surface (the lattice border)
@@ -225,22 +226,6 @@ public:
                 margins->smallest_hole_kept = int(longest[i]);
         }
         return fill;
-    }
-
-    /// The median over the vertices of `loop` (of `all`) of the local spacing (`spacing`, per
-    /// sample) of their nearest sample.
-    static double LocalSpacing(const CoreMesh& all, const BoundaryLoop& loop, const SampleIndex& samples,
-                               const Eigen::VectorXd& spacing)
-    {
-        std::vector<double> near;
-        SampleIndex::Queue queue;
-        for (int v : loop.vertices) {
-            const vcg::Point3d& q = all.vert[size_t(v)].cP();
-            samples.Nearest(Eigen::Vector3d(q[0], q[1], q[2]), 1, queue);
-            near.push_back(spacing[queue.getIndex(0)]);
-        }
-        std::nth_element(near.begin(), near.begin() + long(near.size() / 2), near.end());
-        return near[near.size() / 2];
     }
 
     /// Per hole region of `all` (its faces from mc.surface_faces on) with `regions[i]` set, the

@@ -90,7 +90,8 @@ public:
         if (!(spacing > 0))
             return Result();
         return CloseWhere(mesh, [&](const BoundaryLoop& loop, const std::vector<int>& faceOfVertex) {
-            const double band = kBand * std::max(spacing, local ? SpacingAt(mesh, loop, samples, *local) : 0.0);
+            const double band =
+                kBand * std::max(spacing, local ? BoundaryLoops::SpacingAround(mesh, loop, samples, *local) : 0.0);
             const double limit =
                 std::max(kReach, SurfaceGap(mesh, loop, faceOfVertex, samples, band, kProbeStep * spacing) / spacing);
             return Reach(mesh, loop, samples, spacing, limit) / spacing / limit;
@@ -247,20 +248,6 @@ private:
         for (size_t k = 0; k < points.size(); ++k)
             P.row(Eigen::Index(k)) = points[k].transpose();
         return P;
-    }
-
-    /// The median of the `local` spacings of the samples nearest to the vertices of `loop`.
-    static double SpacingAt(const CoreMesh& mesh, const BoundaryLoop& loop, const SampleIndex& samples,
-                            const Eigen::VectorXd& local)
-    {
-        std::vector<double> around;
-        SampleIndex::Queue queue;
-        for (int v : loop.vertices) {
-            samples.Nearest(PositionOf(mesh, v), 1, queue);
-            around.push_back(local[Eigen::Index(queue.getIndex(0))]);
-        }
-        std::nth_element(around.begin(), around.begin() + long(around.size() / 2), around.end());
-        return around[around.size() / 2];
     }
 
     /// The largest distance from points of the triangle a b c (a barycentric grid `step` apart
