@@ -65,6 +65,19 @@ size_t VerticesOf(const CoreMesh& m, const std::vector<char>& inSurface, char wh
 
 const Eigen::VectorXd kNoSpacing;
 
+/// Samples where TwoHoles' SODS is: the unit sphere above z = 0.3, outside the cylinder of
+/// radius 0.25 around the z axis.
+Points SamplesOfTheCap()
+{
+    Points all, allNormals;
+    test::SpherePoints(20000, 1.0, all, allNormals, 0.3);
+    std::vector<Eigen::Index> kept;
+    for (Eigen::Index i = 0; i < all.rows(); ++i)
+        if (all.row(i).head<2>().norm() > 0.25)
+            kept.push_back(i);
+    return all(kept, Eigen::all);
+}
+
 } // namespace
 
 TEST(BoundaryStage, SmallHolesFillsTheSmallClosedHoleAndKeepsTheLargeOne)
@@ -121,14 +134,7 @@ TEST(BoundaryStage, ABalloonIsKeptAPatchInsideTheSameLoopIsFilled)
 TEST(BoundaryStage, RegionDepthsAndTheCoverageRule)
 {
     TwoHoles h;
-    // Samples where the SODS is: the sphere above z = 0.3, outside the cylinder of radius 0.25.
-    Points all, allNormals;
-    test::SpherePoints(20000, 1.0, all, allNormals, 0.3);
-    std::vector<Eigen::Index> kept;
-    for (Eigen::Index i = 0; i < all.rows(); ++i)
-        if (all.row(i).head<2>().norm() > 0.25)
-            kept.push_back(i);
-    const Points P = all(kept, Eigen::all);
+    const Points P = SamplesOfTheCap();
     const SampleIndex samples(P);
     const Eigen::VectorXd tenth = Eigen::VectorXd::Constant(P.rows(), 0.1);
     std::vector<char> both(2, 1), bottomOnly(2, 0);
@@ -159,13 +165,7 @@ TEST(BoundaryStage, ALoopIsCountedInTheEdgesOfItsOwnSampling)
     BoundaryStage::SmallHoles(h.all, h.inSurface, h.mc, 1000, nullptr, kNoSpacing, 1, edges);
     const int small = *std::min_element(edges.begin(), edges.end());
     ASSERT_GE(small, 6);
-    Points all, allNormals;
-    test::SpherePoints(20000, 1.0, all, allNormals, 0.3);
-    std::vector<Eigen::Index> kept;
-    for (Eigen::Index i = 0; i < all.rows(); ++i)
-        if (all.row(i).head<2>().norm() > 0.25)
-            kept.push_back(i);
-    const Points P = all(kept, Eigen::all);
+    const Points P = SamplesOfTheCap();
     const SampleIndex samples(P);
     // The same loop, too long for min_edges where the samples around it are as dense as the
     // median (a rim's samples read up to kRimSpacing times wider), is short where they are three
