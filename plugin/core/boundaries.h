@@ -77,9 +77,9 @@ public:
         return uses;
     }
 
-    /// Sum of the edge lengths of `loop` in `mesh`.
     /// The median, over the vertices of `loop` (of `mesh`), of the local spacing (`spacing`,
-    /// per sample) of their nearest sample: the sampling's scale around the loop.
+    /// per sample) of their nearest sample: the sampling's scale around the loop (0 for a loop
+    /// without vertices).
     static double SpacingAround(const CoreMesh& mesh, const BoundaryLoop& loop, const SampleIndex& samples,
                                 const Eigen::VectorXd& spacing)
     {
@@ -89,10 +89,13 @@ public:
             samples.Nearest(PositionOf(mesh, v), 1, queue);
             around.push_back(spacing[Eigen::Index(queue.getIndex(0))]);
         }
+        if (around.empty())
+            return 0;
         std::nth_element(around.begin(), around.begin() + long(around.size() / 2), around.end());
         return around[around.size() / 2];
     }
 
+    /// Sum of the edge lengths of `loop` in `mesh`.
     static double Length(const CoreMesh& mesh, const BoundaryLoop& loop)
     {
         double length = 0;
