@@ -106,14 +106,7 @@ public:
 
     /// The given normals N (n×3) of the samples, scaled to unit length; rows that are zero, NaN
     /// or infinite are estimated (FillMissing with k neighbours), their count in `filled`.
-    /// Then, as estimated ones, a normal its k nearest neighbours clearly contradict is turned
-    /// (TurnOutvoted), their count in `turned`: a stray sample near the surface comes with any
-    /// normal. With 0.1% strays drawn in the screwdriver's bounding box, one 1.3 local
-    /// spacings off its blade and facing against its neighbours bent the surface out to it
-    /// over 0.6% of the area, up to 1.7 spacings off; turned, no face is farther than 0.5
-    /// spacings from the true surface.
-    static Points Given(const SampleIndex& samples, const Points& N, int k, int threads, size_t& filled,
-                        size_t& turned)
+    static Points Given(const SampleIndex& samples, const Points& N, int k, size_t& filled)
     {
         Points normals = N;
         std::vector<Eigen::Index> missing;
@@ -126,7 +119,6 @@ public:
         }
         FillMissing(samples, normals, missing, k);
         filled = missing.size();
-        turned = TurnOutvoted(samples, k, threads, normals);
         return normals;
     }
 
@@ -305,9 +297,7 @@ private:
     /// noisy normal now and then: an isolated sample or a small group then faces the other way
     /// and bends the implicit function into a dimple (a torus with 0.5%-diagonal noise and 10
     /// neighbours: 1 of 23,130 normals). A normal is turned when its k nearest neighbours clearly disagree:
-    /// the sum of their dot products with it is below minus half the sum of their absolute
-    /// values (a neighbour at right angles, across a crease, abstains: the screwdriver's stray
-    /// above had 11 of 15 neighbours against it and the others across the blade's edge). Decided from the normals as they
+    /// the sum of their dot products with it is below -k/2. Decided from the normals as they
     /// were (one pass, independent of the order and of the thread count); a real fold, where
     /// the surface's two sides meet, has neighbours on both sides and is left alone.
     static size_t TurnOutvoted(const SampleIndex& index, int k, int threads, Points& N)
@@ -320,16 +310,13 @@ private:
             SampleIndex::Queue queue;
             for (size_t i = begin; i < end; ++i) {
                 index.Nearest(P.row(Eigen::Index(i)).transpose(), k + 1, queue);  // +1: itself
-                double agreement = 0, votes = 0;
+                double agreement = 0;
                 for (int q = 0; q < queue.getNofElements(); ++q) {
                     const Eigen::Index j = queue.getIndex(q);
-                    if (j != Eigen::Index(i)) {
-                        const double vote = N.row(j).dot(N.row(Eigen::Index(i)));
-                        agreement += vote;
-                        votes += std::abs(vote);
-                    }
+                    if (j != Eigen::Index(i))
+                        agreement += N.row(j).dot(N.row(Eigen::Index(i)));
                 }
-                turn[i] = agreement < -0.5 * votes;
+                turn[i] = agreement < -0.5 * k;
             }
         });
         size_t turned = 0;

@@ -88,7 +88,7 @@ public:
         double memory_estimate = 0;  ///< the estimated peak, bytes (MemoryBudget::PeakBytes)
         bool normals_estimated = false;
         bool normals_flipped = false;
-        size_t normals_turned = 0;        ///< normals (given or estimated) turned to agree with their neighbours
+        size_t normals_turned = 0;        ///< estimated normals turned to agree with their neighbours
         size_t normals_filled = 0;        ///< zero or NaN normals among given ones, estimated
         double seconds_normals = 0, seconds_implicit = 0, seconds_sods = 0, seconds_extraction = 0,
                seconds_boundaries = 0;
@@ -296,7 +296,7 @@ private:
                                   Result& r, vcg::CallBackPos* cb)
     {
         if (p.normals == NormalSource::LayerOrEstimate && InputCheck::HasNormals(N))
-            return PointNormals::Given(samples, N, p.normal_neighbours, p.threads, r.normals_filled, r.normals_turned);
+            return PointNormals::Given(samples, N, p.normal_neighbours, r.normals_filled);
         if (cb) cb(2, "Estimating normals");
         PointNormals::Param np;
         np.neighbours = p.normal_neighbours;

@@ -56,10 +56,9 @@ TEST(PointNormals, GivenNormalsAreScaledAndMissingOnesFilled)
     N.row(10).setZero();
     N(500, 1) = std::numeric_limits<double>::quiet_NaN();
     N.row(900) << std::numeric_limits<double>::infinity(), 0, 0;
-    size_t filled = 0, turned = 0;
-    const Points given = PointNormals::Given(samples, N, 15, 0, filled, turned);
+    size_t filled = 0;
+    const Points given = PointNormals::Given(samples, N, 15, filled);
     EXPECT_EQ(filled, 3u);
-    EXPECT_EQ(turned, 0u);
     EXPECT_NEAR((given.rowwise().norm().array() - 1).abs().maxCoeff(), 0, 1e-9);
     EXPECT_NEAR((given.topRows(10) + exact.topRows(10)).cwiseAbs().maxCoeff(), 0, 1e-12);  // kept
     EXPECT_GT(LeastOutward(P, -given), 0.98);  // the filled ones face inward too
@@ -69,20 +68,6 @@ TEST(PointNormals, GivenNormalsAreScaledAndMissingOnesFilled)
     std::iota(all.begin(), all.end(), Eigen::Index(0));
     PointNormals::FillMissing(samples, none, all, 15);
     EXPECT_GT(LeastOutward(P, none), 0.98);
-}
-
-TEST(PointNormals, AGivenNormalItsNeighboursContradictIsTurned)
-{
-    Points P, exact;
-    test::SpherePoints(1000, 1.0, P, exact);
-    const SampleIndex samples(P);
-    Points N = exact;
-    for (Eigen::Index i : {10, 400, 900})  // isolated normals facing inward
-        N.row(i) *= -1;
-    size_t filled = 0, turned = 0;
-    const Points given = PointNormals::Given(samples, N, 15, 0, filled, turned);
-    EXPECT_EQ(turned, 3u);
-    EXPECT_GT(LeastOutward(P, given), 0.98);
 }
 
 TEST(PointNormals, FlatScanNormalsAreItsPlanes)
