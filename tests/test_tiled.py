@@ -83,6 +83,36 @@ def test_holes_across_seams_are_filled_or_kept_as_one_run_decides(plugin):
         assert any(loop[:, a].min() < plane < loop[:, a].max() for a, plane in ((0, x), (1, y)))
 
 
+def test_holes_filled_at_a_raised_min_boundary_edges_are_decided_as_one_run_does(plugin):
+    # At min_boundary_edges 400 one run fills the terrain's pond (25 spacings in radius) and a
+    # hole of 20 spacings cut on a seam of its 4 tiles. The pond reaches 42
+    # spacings past the seam, beyond a halo of 40: the halo grows with min_boundary_edges so
+    # that every tile sees whole each hole it may fill (with 40, the tile beside the pond kept
+    # it open: 2 loops).
+    spacing = 0.006
+    points, normals = terrain_with_pond(spacing=spacing, noise=0.0, seed=1)
+    x = tiled.plan(points, tiles=4).planes[0][1]
+    keep = np.hypot(points[:, 0] - x, points[:, 1] - 0.75) > 20 * spacing
+    points, normals = points[keep], normals[keep]
+    params = dict(min_boundary_edges=400, **UNSMOOTHED)
+    p = tiled.plan(points, tiles=4, min_boundary_edges=400)
+    assert p.halo > 0.15 + 0.1  # the pond's radius and its centre's distance to the seam
+    one = reconstruct(points, normals, **p.filter_params(p.origin, p.origin), **params)
+    assert len(one.loops) == 1 and one.info["holes_filled"] == 2
+    joined = tiled.reconstruct(points, normals, tiles=4, workers=2, **params)
+    assert joined.info["halo"] == pytest.approx(p.halo)
+    assert [len(loop) for loop in joined.loops] == [len(loop) for loop in one.loops]
+    assert len(joined.faces) == len(one.faces)
+
+
+def test_the_halo_grows_with_the_widest_hole_the_filter_may_fill():
+    spacing, cell = 1.0, tiled.CELL_PER_SPACING
+    assert tiled.halo_width(spacing, cell, 0) == tiled.HALO_SPACINGS
+    assert tiled.halo_width(spacing, cell) == pytest.approx(tiled.HALO_SPACINGS + 12 * np.sqrt(3) / 2 * cell)
+    assert tiled.halo_width(spacing, 100.0, 12) == pytest.approx(40 + 12 * np.sqrt(3) / 2 * 100)
+    assert tiled.halo_width(spacing, 20.0, 0) == 60  # at least 3 cells
+
+
 def test_the_plan_covers_every_sample_with_grid_aligned_blocks(cap):
     points, _ = cap
     p = tiled.plan(points, tiles=8)

@@ -136,7 +136,8 @@ def cmd_tiled(args) -> int:
                           tile_cells=args.tile_cells, workers=args.workers, scheduler=args.scheduler,
                           progress=True, output=str(out), **params)
     sizes = ", ".join(str(len(loop)) for loop in r.loops) or "none"
-    print(f"\n{r.info['tiles']} tiles (cell {r.info['cell_size']:.4g}), {r.info['face_count']} faces")
+    print(f"\n{r.info['tiles']} tiles (cell {r.info['cell_size']:.4g}, halo {r.info['halo']:.4g}: "
+          f"{r.info['halo'] / r.info['sample_spacing']:.0f} spacings), {r.info['face_count']} faces")
     print(f"{len(r.loops)} boundary loops kept; edges per loop: {sizes}")
     print(f"wrote {out.resolve()}")
     return 0

@@ -28,6 +28,8 @@ CELL_PER_SPACING = 0.6
 HALO_SPACINGS = 40
 #: Lattice cells between the samples' box and the lattice's border.
 MARGIN_CELLS = 4
+#: The filter's min_boundary_edges default (BoundaryStage::kDefaultMinBoundaryEdges).
+MIN_BOUNDARY_EDGES = 12
 
 
 @dataclass
@@ -63,16 +65,28 @@ class Plan:
                     lattice_spacing=self.spacing, block_min=lo, block_max=hi)
 
 
-def plan(points, normals=None, resolution: int = 0, tiles: Optional[int] = None, tile_cells: int = 512) -> Plan:
+def plan(points, normals=None, resolution: int = 0, tiles: Optional[int] = None, tile_cells: int = 512,
+         min_boundary_edges: int = MIN_BOUNDARY_EDGES) -> Plan:
     """The lattice and blocks for the samples (an (n, 3) array or files; tile_input.survey reads
     their box and spacing): cells of 0.6 spacings (the filter's automatic resolution, uncapped)
     or of longest side / `resolution`; blocks of about `tile_cells` cells a side, or at least
-    `tiles` blocks, the longest blocks split first."""
+    `tiles` blocks, the longest blocks split first; the halo: see halo_width."""
     lo, hi, spacing, _ = survey(points, normals)
-    return _plan(lo, hi, spacing, resolution, tiles, tile_cells)
+    return _plan(lo, hi, spacing, resolution, tiles, tile_cells, min_boundary_edges)
 
 
-def _plan(lo, hi, spacing: float, resolution: int, tiles: Optional[int], tile_cells: int) -> Plan:
+def halo_width(spacing: float, cell: float, min_boundary_edges: int = MIN_BOUNDARY_EDGES) -> float:
+    """How far around its block a tile reads samples: HALO_SPACINGS, for one run's values
+    everywhere in the block, plus the widest hole the filter may fill as undersampling, so that
+    a tile sees whole every such hole that reaches into its block and decides it as one run
+    does. A hole is filled when its loops have fewer than `min_boundary_edges` edges (counted
+    at the median spacing); a marching-cubes edge lies in one cell, so it is at most sqrt(3)
+    cells long, and a loop of E edges spans at most E sqrt(3) / 2 cells. At least 3 cells."""
+    return max(HALO_SPACINGS * spacing + max(0, min_boundary_edges) * np.sqrt(3) / 2 * cell, 3 * cell)
+
+
+def _plan(lo, hi, spacing: float, resolution: int, tiles: Optional[int], tile_cells: int,
+          min_boundary_edges: int = MIN_BOUNDARY_EDGES) -> Plan:
     if not spacing > 0:
         raise ValueError("the samples have no spacing (all at one position?)")
     cell = (hi - lo).max() / resolution if resolution else CELL_PER_SPACING * spacing
@@ -89,7 +103,7 @@ def _plan(lo, hi, spacing: float, resolution: int, tiles: Optional[int], tile_ce
     counts = np.minimum(counts, cells)
     planes = tuple(origin[a] + cell * np.round(np.linspace(0, cells[a], counts[a] + 1)).astype(np.float64)
                    for a in range(3))
-    return Plan(float(cell), origin, end, spacing, planes, max(HALO_SPACINGS * spacing, 3 * cell))
+    return Plan(float(cell), origin, end, spacing, planes, halo_width(spacing, cell, min_boundary_edges))
 
 
 def _reconstruct_tile(points: np.ndarray, normals: np.ndarray, params: Dict[str, object]):
@@ -159,7 +173,8 @@ def reconstruct(points_or_files: Union[np.ndarray, str, Sequence[str]], normals:
                          "by propagation, their orientations would not agree across tiles. Give the normals, "
                          "or a viewpoint they face (viewpoint=...; the CLI's --viewpoint), or reconstruct "
                          "in one run.")
-    p = _plan(lo, hi, spacing, resolution, tiles, tile_cells)
+    p = _plan(lo, hi, spacing, resolution, tiles, tile_cells,
+              int(filter_params.get("min_boundary_edges", MIN_BOUNDARY_EDGES)))
     bins = Bins(p.planes, p.halo)
     for points, given in chunks(source, normals):  # normals facing the viewpoint: zero, the filter's to fill
         bins.add(points, given if given is not None else np.zeros_like(points))
