@@ -15,27 +15,22 @@ def cap():
     return wavy_cap(200_000, seed=3)
 
 
-#: Boundary smoothing off: its sweep along a loop moves each vertex after the one before it, so
-#: where a loop starts leaves a trace (up to half a cell at a few vertices), and a tile's loop
-#: starts elsewhere than one run's. Everything else a tile computes is one run's (vertices
-#: within 1e-5 cells: the boundary fit's sums run over the samples in another order).
-UNSMOOTHED = dict(boundary_smoothing=0)
-
-
 @pytest.fixture(scope="module")
 def joined(plugin, cap):
     points, normals = cap
-    return tiled.reconstruct(points, normals, tiles=8, workers=2, **UNSMOOTHED)
+    return tiled.reconstruct(points, normals, tiles=8, workers=2)
 
 
 def test_eight_tiles_on_two_workers_join_into_the_single_runs_surface(plugin, cap, joined):
     # 200,000 random samples of an open wavy cap, in at least 8 tiles on a local cluster of 2
     # worker processes, against one run on the same lattice: the same loops, edge for edge, the
-    # same faces, and every vertex on the one run's surface, to a thousandth of a cell.
+    # same faces, and every vertex on the one run's surface, to a thousandth of a cell, boundary
+    # smoothing and fit included (with the smoothing swept from where each loop was entered, a
+    # vertex was half a cell off).
     points, normals = cap
     p = tiled.plan(points, tiles=8)
     assert joined.info["tiles"] >= 8
-    one = reconstruct(points, normals, **p.filter_params(p.origin, p.origin), **UNSMOOTHED)  # equal corners: all faces
+    one = reconstruct(points, normals, **p.filter_params(p.origin, p.origin))  # equal corners: all faces
     assert [len(loop) for loop in joined.loops] == [len(loop) for loop in one.loops]
     assert len(one.loops) >= 1 and len(one.loops[0]) > 1000  # the rim
     assert len(joined.faces) == len(one.faces)
@@ -71,8 +66,8 @@ def test_holes_across_seams_are_filled_or_kept_as_one_run_decides(plugin):
     points, normals = points[keep], normals[keep]
     p = tiled.plan(points, tiles=4)
     assert np.allclose([p.planes[0][1], p.planes[1][1]], [x, y], atol=p.cell)
-    one = reconstruct(points, normals, **p.filter_params(p.origin, p.origin), **UNSMOOTHED)
-    joined = tiled.reconstruct(points, normals, tiles=4, workers=2, **UNSMOOTHED)
+    one = reconstruct(points, normals, **p.filter_params(p.origin, p.origin))
+    joined = tiled.reconstruct(points, normals, tiles=4, workers=2)
     assert [len(loop) for loop in joined.loops] == [len(loop) for loop in one.loops]
     assert len(joined.faces) == len(one.faces)
     # The border and the pond, and three of the cut holes; the two smallest were filled.
@@ -94,7 +89,7 @@ def test_holes_filled_at_a_raised_min_boundary_edges_are_decided_as_one_run_does
     x = tiled.plan(points, tiles=4).planes[0][1]
     keep = np.hypot(points[:, 0] - x, points[:, 1] - 0.75) > 20 * spacing
     points, normals = points[keep], normals[keep]
-    params = dict(min_boundary_edges=400, **UNSMOOTHED)
+    params = dict(min_boundary_edges=400)
     p = tiled.plan(points, tiles=4, min_boundary_edges=400)
     assert p.halo > 0.15 + 0.1  # the pond's radius and its centre's distance to the seam
     one = reconstruct(points, normals, **p.filter_params(p.origin, p.origin), **params)

@@ -3,10 +3,10 @@
 Each piece (a tile's faces) is kept on disk as it arrives. Only its border vertices can be
 shared with another piece (a face of the neighbouring block meets them there), so only those
 are welded: border vertices of different pieces within the tolerance are one vertex. The tiles
-compute them from the same lattice corners, but near a scan's boundary the boundary stage's
-moves (smoothing sweeps along a loop that starts elsewhere in each tile, the vertices that
-follow the fit) leave them up to 0.002 cells apart (measured on a terrain in 4 tiles). The boundary loops of the whole are the pieces' border edges
-that no other piece has, traced into cycles. The joined mesh is then read back into arrays or
+compute them from the same lattice corners and samples, but sums over the samples in another
+order (the boundary fit's) can leave them a few millionths of a cell apart near a scan's
+boundary; a hundredth of a cell is far below any edge. The boundary loops of the whole are the
+pieces' border edges that no other piece has, traced into cycles. The joined mesh is then read back into arrays or
 streamed to a binary PLY file piece by piece.
 """
 import tempfile

@@ -91,3 +91,29 @@ TEST(BoundarySmoothing, VerticesStayOnTheImplicitSurface)
     EXPECT_LT(OffSphere(projected, loops[0]), 1e-5);
     EXPECT_LT(Zig(projected), 0.25 * zig);
 }
+
+TEST(BoundarySmoothing, TheResultDoesNotDependOnWhereTheLoopIsEntered)
+{
+    // A tile of a tiled run traces a loop from another vertex than one run does: the same loop
+    // entered at each of its vertices is smoothed to the same positions.
+    CoreMesh first;
+    ZigZagCap(first, true);
+    const auto loops = BoundaryLoops::Compute(first);
+    ASSERT_EQ(loops.size(), 1u);
+    BoundarySmoothing::Param p;
+    p.cell_size = 0.1;
+    p.newton_steps = 0;
+    BoundarySmoothing::Compute(first, loops, nullptr, p);
+    const size_t n = loops[0].vertices.size();
+    for (size_t shift = 1; shift < n; ++shift) {
+        CoreMesh other;
+        ZigZagCap(other, true);
+        std::vector<BoundaryLoop> entered = loops;
+        std::rotate(entered[0].vertices.begin(), entered[0].vertices.begin() + long(shift), entered[0].vertices.end());
+        BoundarySmoothing::Compute(other, entered, nullptr, p);
+        double worst = 0;
+        for (int v = 0; v < int(first.vert.size()); ++v)
+            worst = std::max(worst, (PositionOf(first, v) - PositionOf(other, v)).norm());
+        EXPECT_EQ(worst, 0.0) << "entered at loop vertex " << shift;
+    }
+}
