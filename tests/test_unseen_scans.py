@@ -8,6 +8,7 @@ from scipy.spatial import ConvexHull, cKDTree
 
 import implicit_boundaries
 import shapes
+from conftest import SAMPLES
 from shapes import fibonacci_sphere, wavy_cap
 
 
@@ -94,6 +95,32 @@ def test_strays_in_the_empty_space_around_a_scan_are_left_out(plugin, seed):
     assert rec.info["resolution"] == clean.info["resolution"]
     assert rec.info["sods_cells"] == clean.info["sods_cells"]
     assert rec.loops == []
+
+
+def test_strays_in_the_box_of_a_range_scan_are_left_out(plugin):
+    """pymeshlab's raw range scan of a face (its 85,182 triangulated grid points, with their
+    normals) plus 0.1% of strays drawn in its bounding box and one sample at ten times its
+    diagonal. A range scan is a sheet that leaves most of its box empty: 28 of the strays were
+    each other's nearest in one group, larger than a surface's smallest, and stayed; their
+    tangent disks would have filled 63.5M cells (the scan's own: 0.67M) and the filter refused
+    for memory. Now a sparse sample whose neighbourhood is not flat is left out: the lattice
+    and the loops are the clean scan's."""
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(str(SAMPLES / "rangemaps" / "face000.ply"))
+    ms.meshing_remove_unreferenced_vertices()  # the grid points no triangle uses: the scanner's own strays
+    points, normals = ms.current_mesh().vertex_matrix(), ms.current_mesh().vertex_normal_matrix()
+    clean = implicit_boundaries.reconstruct(points, normals)
+    rng = np.random.default_rng(len(points))
+    strays, stray_normals = stray_points(rng, len(points) // 1000, points.min(axis=0), points.max(axis=0))
+    far = points.max(axis=0) + [10 * np.linalg.norm(np.ptp(points, axis=0)), 0, 0]
+    rec = implicit_boundaries.reconstruct(np.vstack([points, strays, [far]]),
+                                          np.vstack([normals, stray_normals, [[1, 0, 0]]]))
+    assert rec.info["resolution"] == clean.info["resolution"]
+    assert rec.info["sods_cells"] < 1.02 * clean.info["sods_cells"]
+    assert len(rec.loops) == len(clean.loops)
+    spacing = clean.info["sample_spacing"]
+    off = cKDTree(points).query(strays)[0] > 2.5 * spacing
+    assert rec.info["outliers_removed"] >= clean.info["outliers_removed"] + off.sum() + 1
 
 
 @pytest.mark.parametrize("fits", [{}, dict(rbf_min_samples=50, rbf_max_samples=160)],

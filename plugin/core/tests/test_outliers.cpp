@@ -76,6 +76,26 @@ TEST(Outliers, FindsAScatterOfStraysThatClaimEachOther)
     EXPECT_EQ(kept.back(), Eigen::Index(surface - 1));
 }
 
+TEST(Outliers, FindsAScatterOfStraysLargerThanAGroupInTheBoxOfASheet)
+{
+    // A range scan is a sheet that leaves most of its bounding box empty: 0.1-0.5% of strays
+    // drawn in that box are each other's nearest in groups larger than kMinGroup. They fill a
+    // volume, as no surface does, however sparse.
+    std::vector<Eigen::RowVector3d> ps;
+    for (double x = -1; x <= 1; x += 0.02)
+        for (double y = -1; y <= 1; y += 0.02)
+            ps.emplace_back(x, y, 0);
+    const size_t surface = ps.size();
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> u(-1, 1), w(0.5, 2);
+    for (int i = 0; i < 50; ++i)
+        ps.emplace_back(u(rng), u(rng), w(rng));
+    const Points P = Stack(ps);
+    const std::vector<Eigen::Index> kept = Outliers::Kept(SampleIndex(P));
+    ASSERT_EQ(kept.size(), surface);
+    EXPECT_EQ(kept.back(), Eigen::Index(surface - 1));
+}
+
 TEST(Outliers, KeepsEveryOneOfFewSamples)
 {
     const Points P = Stack({{0, 0, 0}, {1, 0, 0}, {100, 0, 0}});
