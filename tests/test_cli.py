@@ -197,12 +197,13 @@ def quaternion(axis, degrees):
     return (*(np.sin(half) * np.asarray(axis, dtype=float)), np.cos(half))
 
 
-@pytest.mark.parametrize("alignment", ["aln", "conf"])
+@pytest.mark.parametrize("alignment", ["aln", "mlp", "conf"])
 def test_scans_placed_by_an_alignment_file_are_merged(alignment, tmp_path, capsys, plugin):
     """A sphere scanned as two overlapping caps, the lower one stored in its scanner's frame
     (turned 90 degrees about x, moved), and an alignment file that places it (MeshLab's .aln: its
-    matrix; Stanford's .conf: translation and quaternion, world = R(q)^-1 p + t): one closed
-    sphere. Each cap alone has one loop."""
+    matrix; its project .mlp: each layer's matrix as pymeshlab's load_project reads it, and a
+    hidden layer, left out; Stanford's .conf: translation and quaternion, world = R(q)^-1 p + t):
+    one closed sphere. Each cap alone has one loop."""
     u = fibonacci_sphere(6000)
     upper, lower = u[u[:, 2] > -0.2], u[u[:, 2] < 0.2]
     t = np.array([0.3, -0.2, 0.1])
@@ -219,12 +220,24 @@ def test_scans_placed_by_an_alignment_file_are_merged(alignment, tmp_path, capsy
         world[:3, :3], world[:3, 3] = rotation.T, t
         rows = lambda m: "\n".join(" ".join(f"{x:.17g}" for x in row) for row in m)
         text = f"2\nupper.ply\n#\n{rows(np.eye(4))}\nlower.ply\n#\n{rows(world)}\n0\n"
+    elif alignment == "mlp":
+        world = np.eye(4)
+        world[:3, :3], world[:3, 3] = rotation.T, t
+        layer = lambda name, m, visible=1: (f'<MLMesh visible="{visible}" label="{name}" filename="{name}">'
+                                            f'<MLMatrix44>\n{" ".join(f"{x:.17g}" for x in m.ravel())}\n</MLMatrix44></MLMesh>')
+        text = (f"<!DOCTYPE MeshLabDocument>\n<MeshLabProject><MeshGroup>{layer('upper.ply', np.eye(4))}"
+                f"{layer('lower.ply', world)}{layer('upper.ply', np.eye(4), visible=0)}</MeshGroup></MeshLabProject>")
     else:
         text = ("camera 0 0 0 0 0 0 1\nbmesh upper.ply 0 0 0 0 0 0 1\n"
                 f"bmesh lower.ply {t[0]} {t[1]} {t[2]} {q[0]} {q[1]} {q[2]} {q[3]}\n")
     (tmp_path / f"scans.{alignment}").write_text(text)
     out = tmp_path / "merged.ply"
-    if alignment == "aln":  # the alignment file stands for its scans
+    if alignment == "mlp":  # MeshLab itself places the lower cap where the project says
+        ms = pymeshlab.MeshSet()
+        ms.load_project(str(tmp_path / "scans.mlp"))
+        assert ms.mesh_number() == 3
+        assert np.allclose(ms.mesh(1).transform_matrix(), world)
+    if alignment in ("aln", "mlp"):  # the alignment file stands for its scans
         assert main(["reconstruct", str(tmp_path / f"scans.{alignment}"), "-o", str(out)]) == 0
     else:  # the scans, placed by the alignment file
         assert main(["reconstruct", str(tmp_path / "upper.ply"), str(tmp_path / "lower.ply"),
@@ -242,6 +255,16 @@ def test_a_broken_alignment_file_is_one_line(tmp_path, capsys):
     (tmp_path / "scans.aln").write_text("2\nupper.ply\n#\n1 0 0\n")
     assert main(["reconstruct", str(tmp_path / "scans.aln"), "-o", str(tmp_path / "out.ply")]) == 1
     assert "not a MeshLab alignment" in one_error_line(capsys)
+
+
+def test_a_broken_project_file_is_one_line(tmp_path, capsys):
+    (tmp_path / "scans.mlp").write_text('<MeshLabProject><MeshGroup><MLMesh filename="a.ply"><MLMatrix44>1 0 0'
+                                        '</MLMatrix44></MLMesh></MeshGroup></MeshLabProject>')
+    assert main(["reconstruct", str(tmp_path / "scans.mlp"), "-o", str(tmp_path / "out.ply")]) == 1
+    assert "layer a.ply: its MLMatrix44 is not 16 numbers" in one_error_line(capsys)
+    (tmp_path / "scans.mlp").write_text("<MeshLabProject><MeshGroup>")
+    assert main(["reconstruct", str(tmp_path / "scans.mlp"), "-o", str(tmp_path / "out.ply")]) == 1
+    assert "not a MeshLab project" in one_error_line(capsys)
 
 
 def test_a_scan_missing_from_the_alignment_is_one_line(tmp_path, capsys):

@@ -1,23 +1,26 @@
 """Alignment files that place several range scans in one frame: MeshLab's ``.aln`` (written by
-its Align tool) and the Stanford ``.conf``. Each gives, per scan, its file and the 4x4 matrix M
-that takes the scan's points p to the common frame (M @ [p, 1]), the layer matrix MeshLab
-would give it."""
+its Align tool), its project ``.mlp`` (*File > Save Project*: each layer's file and matrix) and
+the Stanford ``.conf``. Each gives, per scan, its file and the 4x4 matrix M that takes the
+scan's points p to the common frame (M @ [p, 1]), the layer matrix MeshLab would give it."""
+import xml.etree.ElementTree as ElementTree
 from pathlib import Path
 
 import numpy as np
 
 
 def read_alignment(path) -> list:
-    """[(scan path, (4, 4) matrix)] from a ``.aln`` or ``.conf`` file; scan paths are relative to
-    the alignment file's folder. Raises ValueError with the line at fault."""
+    """[(scan path, (4, 4) matrix)] from a ``.aln``, ``.mlp`` or ``.conf`` file; scan paths are
+    relative to the alignment file's folder. Raises ValueError with the line at fault."""
     path = Path(path)
     text = path.read_text().splitlines()
     if path.suffix.lower() == ".conf":
         scans = _conf(text, path)
     elif path.suffix.lower() == ".aln":
         scans = _aln(text, path)
+    elif path.suffix.lower() == ".mlp":
+        scans = _mlp("\n".join(text), path)
     else:
-        raise ValueError(f"{path}: not an alignment file (MeshLab .aln or Stanford .conf)")
+        raise ValueError(f"{path}: not an alignment file (MeshLab .aln or .mlp, or Stanford .conf)")
     if not scans:
         raise ValueError(f"{path}: lists no scans")
     for name, matrix in scans:
@@ -84,4 +87,28 @@ def _aln(lines, path):
     except (ValueError, IndexError):
         raise ValueError(f"{path}: not a MeshLab alignment: a scan count, then per scan its file, '#' and "
                          "4 rows of 4 numbers") from None
+    return scans
+
+
+def _mlp(text, path):
+    """MeshLab project: per visible layer (``<MLMesh visible="1" filename=...>``) its file and its
+    ``<MLMatrix44>`` (16 numbers, row by row; none: the identity). Hidden layers are left out, as
+    MeshLab's *Flatten Visible Layers* leaves them out of a merge."""
+    try:
+        root = ElementTree.fromstring(text)
+    except ElementTree.ParseError as error:
+        raise ValueError(f"{path}: not a MeshLab project ({error})") from None
+    scans = []
+    for layer in root.iter("MLMesh"):
+        name = layer.get("filename")
+        if not name:
+            raise ValueError(f"{path}: a layer ({layer.get('label', 'no label')}) has no filename")
+        if layer.get("visible", "1") == "0":
+            continue
+        element = layer.find("MLMatrix44")
+        try:
+            matrix = np.eye(4) if element is None else np.array(element.text.split(), dtype=float).reshape(4, 4)
+        except (ValueError, AttributeError):
+            raise ValueError(f"{path}: layer {name}: its MLMatrix44 is not 16 numbers") from None
+        scans.append((name, matrix))
     return scans

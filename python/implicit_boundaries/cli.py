@@ -1,7 +1,7 @@
 """Command line: ``implicit-boundaries`` (or ``python -m implicit_boundaries``).
 
 Subcommands: ``reconstruct IN [IN ...] -o OUT`` (any format pymeshlab reads and writes;
-several scans, or an ``.aln``/``.conf`` alignment, give one merged surface), ``tiled IN... -o
+several scans, or an ``.aln``/``.mlp``/``.conf`` alignment, give one merged surface), ``tiled IN... -o
 OUT`` (a large scan tile by tile on Dask), ``compare IN
 [--truth GT] --report DIR`` (side by side with MeshLab's screened Poisson), ``demo``
 (pymeshlab's bunny scan with its holes, reconstructed and compared) and ``info`` (versions,
@@ -28,13 +28,13 @@ DEMO_SCAN = Path(pymeshlab.__file__).parent / "tests" / "sample_meshes" / "bunny
 
 def _scans(inputs, alignment=None) -> list:
     """[(path, matrix or None)] of the command line's inputs: scan files, and alignment files
-    (.aln, .conf) standing for the scans they list, with their matrices. With `alignment`, each
+    (.aln, .mlp, .conf) standing for the scans they list, with their matrices. With `alignment`, each
     scan file gets the matrix that file gives it (matched by file name)."""
     placed = {path.name: matrix for path, matrix in read_alignment(alignment)} if alignment else None
     scans = []
     for name in inputs:
         path = Path(name)
-        if path.suffix.lower() in (".aln", ".conf"):
+        if path.suffix.lower() in (".aln", ".mlp", ".conf"):
             scans += read_alignment(path)
         elif placed is not None:
             if path.name not in placed:
@@ -205,10 +205,10 @@ def _parser() -> argparse.ArgumentParser:
 
     r = sub.add_parser("reconstruct", help="reconstruct point cloud files into a mesh file")
     r.add_argument("input", nargs="+",
-                   help="a scan, or several (merged into one surface), or a MeshLab .aln / Stanford .conf "
-                        "alignment standing for the scans it lists, each placed by its matrix")
+                   help="a scan, or several (merged into one surface), or a MeshLab .aln / .mlp project / "
+                        "Stanford .conf alignment standing for the scans it lists, each placed by its matrix")
     r.add_argument("--alignment", metavar="FILE",
-                   help="a MeshLab .aln or Stanford .conf file that places the scans given (by file name)")
+                   help="a MeshLab .aln or .mlp or Stanford .conf file that places the scans given (by file name)")
     r.add_argument("-o", "--output", required=True)
     options(r)
     r.set_defaults(run=cmd_reconstruct)
