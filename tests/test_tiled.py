@@ -163,6 +163,14 @@ def test_the_command_line_refuses_estimated_normals(tmp_path, capsys):
     assert "oriented by propagation" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize("alignment", ["project.aln", "project.mlp", "bun.conf"])
+def test_the_command_line_refuses_an_alignment_and_says_what_merges_it(alignment, tmp_path, capsys):
+    from implicit_boundaries.cli import main
+    assert main(["tiled", str(tmp_path / alignment), "-o", str(tmp_path / "o.ply")]) == 1
+    error = capsys.readouterr().err
+    assert "not an alignment" in error and f"implicit-boundaries reconstruct {tmp_path / alignment}" in error
+
+
 def _grid(n):
     """A flat n x n grid of unit squares, two triangles each: (vertices, faces)."""
     i, j = np.meshgrid(np.arange(n + 1), np.arange(n + 1), indexing="ij")

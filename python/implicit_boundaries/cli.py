@@ -128,6 +128,11 @@ def cmd_tiled(args) -> int:
     if params.pop("normals", None) == Normals.ESTIMATE:
         raise ValueError("tiled runs use the scans' own normals, or normals estimated facing --viewpoint: "
                          "oriented by propagation (--estimate-normals), tiles would not agree")
+    for name in args.input:
+        if Path(name).suffix.lower() in (".aln", ".mlp", ".conf"):
+            raise ValueError(f"{name}: tiled runs take point files, not an alignment; merge the aligned scans with "
+                             f"'implicit-boundaries reconstruct {name}', or save them as one point file "
+                             "(MeshLab: Flatten Visible Layers) and tile that")
     out = Path(args.output)
     if out.suffix.lower() != ".ply":
         raise ValueError(f"{out}: tiled runs write binary PLY, streamed tile by tile: name the output .ply")
