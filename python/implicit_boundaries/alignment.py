@@ -7,18 +7,20 @@ from pathlib import Path
 
 import numpy as np
 
+SUFFIXES = (".aln", ".mlp", ".conf")  # the files read_alignment reads
+
 
 def read_alignment(path) -> list:
     """[(scan path, (4, 4) matrix)] from a ``.aln``, ``.mlp`` or ``.conf`` file; scan paths are
     relative to the alignment file's folder. Raises ValueError with the line at fault."""
     path = Path(path)
-    text = path.read_text().splitlines()
+    text = path.read_text()
     if path.suffix.lower() == ".conf":
-        scans = _conf(text, path)
+        scans = _conf(text.splitlines(), path)
     elif path.suffix.lower() == ".aln":
-        scans = _aln(text, path)
+        scans = _aln(text.splitlines(), path)
     elif path.suffix.lower() == ".mlp":
-        scans = _mlp("\n".join(text), path)
+        scans = _mlp(text, path)
     else:
         raise ValueError(f"{path}: not an alignment file (MeshLab .aln or .mlp, or Stanford .conf)")
     if not scans:

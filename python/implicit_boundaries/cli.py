@@ -17,7 +17,7 @@ import numpy as np
 import pymeshlab
 
 from ._plugin import FILTER_NAME, PluginMismatchError, apply, describe_build, load, plugin_build, plugin_path
-from .alignment import read_alignment
+from .alignment import SUFFIXES as ALIGNMENT_SUFFIXES, read_alignment
 from .cloud import add_layer, read_cloud
 from .compare import compare
 from .options import Normals, SodsOccupancy
@@ -34,7 +34,7 @@ def _scans(inputs, alignment=None) -> list:
     scans = []
     for name in inputs:
         path = Path(name)
-        if path.suffix.lower() in (".aln", ".mlp", ".conf"):
+        if path.suffix.lower() in ALIGNMENT_SUFFIXES:
             scans += read_alignment(path)
         elif placed is not None:
             if path.name not in placed:
@@ -129,7 +129,7 @@ def cmd_tiled(args) -> int:
         raise ValueError("tiled runs use the scans' own normals, or normals estimated facing --viewpoint: "
                          "oriented by propagation (--estimate-normals), tiles would not agree")
     for name in args.input:
-        if Path(name).suffix.lower() in (".aln", ".mlp", ".conf"):
+        if Path(name).suffix.lower() in ALIGNMENT_SUFFIXES:
             raise ValueError(f"{name}: tiled runs take point files, not an alignment; merge the aligned scans with "
                              f"'implicit-boundaries reconstruct {name}', or save them as one point file "
                              "(MeshLab: Flatten Visible Layers) and tile that")
