@@ -215,14 +215,12 @@ def test_scans_placed_by_an_alignment_file_are_merged(alignment, tmp_path, capsy
         normals = upper if name == "upper" else lower @ rotation.T  # outward, turned with the points
         ms.add_mesh(pymeshlab.Mesh(vertex_matrix=points, v_normals_matrix=normals))
         ms.save_current_mesh(str(tmp_path / f"{name}.ply"))
+    world = np.eye(4)  # the matrix that places the lower cap (.aln, .mlp)
+    world[:3, :3], world[:3, 3] = rotation.T, t
     if alignment == "aln":
-        world = np.eye(4)
-        world[:3, :3], world[:3, 3] = rotation.T, t
         rows = lambda m: "\n".join(" ".join(f"{x:.17g}" for x in row) for row in m)
         text = f"2\nupper.ply\n#\n{rows(np.eye(4))}\nlower.ply\n#\n{rows(world)}\n0\n"
     elif alignment == "mlp":
-        world = np.eye(4)
-        world[:3, :3], world[:3, 3] = rotation.T, t
         layer = lambda name, m, visible=1: (f'<MLMesh visible="{visible}" label="{name}" filename="{name}">'
                                             f'<MLMatrix44>\n{" ".join(f"{x:.17g}" for x in m.ravel())}\n</MLMatrix44></MLMesh>')
         text = (f"<!DOCTYPE MeshLabDocument>\n<MeshLabProject><MeshGroup>{layer('upper.ply', np.eye(4))}"
