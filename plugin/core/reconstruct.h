@@ -146,7 +146,7 @@ private:
 
         if (cb) cb(5, "Building the implicit function");
         const std::vector<int> scan = ScanOfSamples(p.scan_sizes, input.rows(), kept);
-        const Eigen::VectorXd spacing = SampleSpacing::PerScan(samples, scan, p.threads);
+        const Eigen::VectorXd spacing = SampleSpacing::PerScan(samples, scan, p.threads, &normals);
         r.sample_spacing = p.tile.spacing > 0 ? p.tile.spacing : SampleSpacing::Median(spacing);
         const Eigen::Vector3d lo = P.colwise().minCoeff().transpose(), hi = P.colwise().maxCoeff().transpose();
         const double longest = (hi - lo).maxCoeff();
@@ -270,7 +270,7 @@ private:
         if (p.implicit == Implicit::Hoppe)
             return std::make_unique<HoppeDistance>(samples, N, p.hoppe_neighbours, p.threads);
         PuRbf::Param rp =
-            p.scan_sizes.size() > 1 ? p.rbf.PerSheet(SampleSpacing::Overlap(samples, spacing, p.threads)) : p.rbf;
+            p.scan_sizes.size() > 1 ? p.rbf.PerSheet(SampleSpacing::Overlap(samples, spacing, p.threads, &N)) : p.rbf;
         rp.threads = p.threads;
         rp.spacing = spacing;
         rp.root = p.tile.Root();

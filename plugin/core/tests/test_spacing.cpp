@@ -68,6 +68,31 @@ TEST(SampleSpacing, RegularGridGivesItsSpacing)
     EXPECT_NEAR(SampleSpacing::Median(SampleSpacing::Local(SampleIndex(Q))), 3 * InnerSpacing(h), 1e-12);
 }
 
+TEST(SampleSpacing, NoiseAcrossTheSurfaceIsNotSpacingAlongIt)
+{
+    // The grid of spacing h with every sample moved up to 0.3 h off its plane: the 8 nearest
+    // are still the inner ring's (their squared distances stay within h^2 + 0.36 h^2 and
+    // 2 h^2 + 0.36 h^2, below the next ring's 4 h^2).
+    const double h = 0.01;
+    Points P = Stack(Grid(30, h, 0));
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> off(-0.15 * h, 0.15 * h);
+    for (Eigen::Index i = 0; i < P.rows(); ++i)
+        P(i, 2) = off(rng);
+    const SampleIndex samples(P);
+    Points N = Points::Zero(P.rows(), 3);
+    N.col(2).setOnes();
+    const Eigen::VectorXd along = SampleSpacing::Local(samples, 1, 1, &N), inSpace = SampleSpacing::Local(samples);
+    for (Eigen::Index i = 0; i < P.rows(); ++i)
+        if (Inner(int(i), 30)) {
+            EXPECT_NEAR(along[i], InnerSpacing(h), 1e-12) << i;
+        }
+    EXPECT_GT(SampleSpacing::Median(inSpace), 1.002 * InnerSpacing(h));  // the offsets count there
+    // A sample without a normal (a zero row) is measured in space.
+    N.row(100).setZero();
+    EXPECT_EQ(SampleSpacing::Local(samples, 1, 1, &N)[100], inSpace[100]);
+}
+
 TEST(SampleSpacing, MedianIsTheMiddleValue)
 {
     EXPECT_EQ(SampleSpacing::Median((Eigen::VectorXd(3) << 3, 1, 2).finished()), 2);
