@@ -28,7 +28,7 @@ def test_eight_tiles_on_two_workers_join_into_the_single_runs_surface(plugin, ca
     # smoothing and fit included (with the smoothing swept from where each loop was entered, a
     # vertex was half a cell off).
     points, normals = cap
-    p = tiled.plan(points, tiles=8)
+    p = tiled.plan(points, normals, tiles=8)
     assert joined.info["tiles"] >= 8
     one = reconstruct(points, normals, **p.filter_params(p.origin, p.origin))  # equal corners: all faces
     assert [len(loop) for loop in joined.loops] == [len(loop) for loop in one.loops]
@@ -41,8 +41,8 @@ def test_eight_tiles_on_two_workers_join_into_the_single_runs_surface(plugin, ca
 def test_seams_hold_no_border_edge(cap, joined):
     # No border edge runs along a block's plane inside the scan: every border vertex off the
     # rim (z near -0.2) belongs to a small gap of the random sampling, none lies on a seam.
-    points, _ = cap
-    p = tiled.plan(points, tiles=8)
+    points, normals = cap
+    p = tiled.plan(points, normals, tiles=8)
     border = joined.vertices[np.unique(boundary_edges(joined.faces))]
     for axis in range(3):
         inner = p.planes[axis][1:-1]
@@ -58,13 +58,13 @@ def test_holes_across_seams_are_filled_or_kept_as_one_run_decides(plugin):
     # stay open, and the joined surface has one run's loops, edge for edge, and its faces.
     spacing = 0.006
     points, normals = terrain_with_pond(spacing=spacing, noise=0.0, seed=1)
-    x, y = (tiled.plan(points, tiles=4).planes[a][1] for a in range(2))
+    x, y = (tiled.plan(points, normals, tiles=4).planes[a][1] for a in range(2))
     holes = [((x, 0.15), 5.0), ((x, 0.8), 2.0), ((x, 0.92), 2.4), ((0.1, y), 2.2), ((0.25, y), 2.6), ((0.35, y), 4.0)]
     keep = np.ones(len(points), dtype=bool)
     for (cx, cy), radius in holes:
         keep &= np.hypot(points[:, 0] - cx, points[:, 1] - cy) > radius * spacing
     points, normals = points[keep], normals[keep]
-    p = tiled.plan(points, tiles=4)
+    p = tiled.plan(points, normals, tiles=4)
     assert np.allclose([p.planes[0][1], p.planes[1][1]], [x, y], atol=p.cell)
     one = reconstruct(points, normals, **p.filter_params(p.origin, p.origin))
     joined = tiled.reconstruct(points, normals, tiles=4, workers=2)
@@ -86,11 +86,11 @@ def test_holes_filled_at_a_raised_min_boundary_edges_are_decided_as_one_run_does
     # it open: 2 loops).
     spacing = 0.006
     points, normals = terrain_with_pond(spacing=spacing, noise=0.0, seed=1)
-    x = tiled.plan(points, tiles=4).planes[0][1]
+    x = tiled.plan(points, normals, tiles=4).planes[0][1]
     keep = np.hypot(points[:, 0] - x, points[:, 1] - 0.75) > 20 * spacing
     points, normals = points[keep], normals[keep]
     params = dict(min_boundary_edges=400)
-    p = tiled.plan(points, tiles=4, min_boundary_edges=400)
+    p = tiled.plan(points, normals, tiles=4, min_boundary_edges=400)
     assert p.halo > 0.15 + 0.1  # the pond's radius and its centre's distance to the seam
     one = reconstruct(points, normals, **p.filter_params(p.origin, p.origin), **params)
     assert len(one.loops) == 1 and one.info["holes_filled"] == 2
@@ -109,8 +109,8 @@ def test_the_halo_grows_with_the_widest_hole_the_filter_may_fill():
 
 
 def test_the_plan_covers_every_sample_with_grid_aligned_blocks(cap):
-    points, _ = cap
-    p = tiled.plan(points, tiles=8)
+    points, normals = cap
+    p = tiled.plan(points, normals, tiles=8)
     assert p.count() >= 8
     assert np.all(points >= p.origin) and np.all(points <= p.end)
     for axis in range(3):

@@ -100,7 +100,7 @@ def survey(source, normals=None, seed: int = 0) -> Tuple[np.ndarray, np.ndarray,
     """(lo, hi, median spacing, whether every chunk has normals) of the samples, in three passes.
 
     The spacing is the filter's (spacing.h: sqrt(pi r8^2 / 8), r8 the distance to the 8th
-    nearest neighbour), measured on the samples of up to 40 voxels drawn by their counts, voxels
+    nearest neighbour, in the sample's tangent plane when the samples have normals), measured on the samples of up to 40 voxels drawn by their counts, voxels
     coarse enough to hold 2,000 samples on average, at the seeds more than 3 median r8 inside
     their voxel (so their neighbours are all there; a rule on the seed's own r8 would favour
     the dense ones)."""
@@ -127,13 +127,17 @@ def survey(source, normals=None, seed: int = 0) -> Tuple[np.ndarray, np.ndarray,
     side = fine * factor
     rng = np.random.default_rng(seed)
     chosen = rng.choice(keys, size=min(SPACING_VOXELS, len(keys)), replace=False, p=n / n.sum())
-    inside = np.concatenate([points[np.isin(_voxel(points, lo, side), chosen)] for points, _ in chunks(source, normals)])
+    picked = [(points[m], n[m] if with_normals else None)
+              for points, n in chunks(source, normals) for m in [np.isin(_voxel(points, lo, side), chosen)]]
+    inside = np.concatenate([p for p, _ in picked])
+    inside_normals = np.concatenate([n for _, n in picked]) if with_normals else None
     spacings = []
     for key in chosen:
-        at = inside[_voxel(inside, lo, side) == key]
+        mask = _voxel(inside, lo, side) == key
+        at = inside[mask]
         if len(at) < 10:
             continue
-        r8 = cKDTree(at).query(at, k=9)[0][:, 8]
+        r8 = _reach8(at, inside_normals[mask] if with_normals else None)
         corner = lo + side * np.array(_unkey(key), dtype=np.float64)
         wall = np.minimum(at - corner, corner + side - at).min(axis=1)
         spacings.append(np.sqrt(np.pi * r8[wall > 3 * np.median(r8)] ** 2 / 8))
@@ -141,6 +145,20 @@ def survey(source, normals=None, seed: int = 0) -> Tuple[np.ndarray, np.ndarray,
     if len(spacing) == 0:
         raise ValueError("too few samples to measure their spacing (at least 10 close together are needed)")
     return lo, hi, float(np.median(spacing)), bool(with_normals)
+
+
+def _reach8(points: np.ndarray, normals: Optional[np.ndarray]) -> np.ndarray:
+    """Per sample, the distance to the farthest of its 8 nearest neighbours, as spacing.h
+    measures it: with normals, in the sample's tangent plane, but in space for a neighbour whose
+    normal faces away (across a thin part)."""
+    distance, index = cKDTree(points).query(points, k=9)
+    if normals is None:
+        return distance[:, 8]
+    n = normals / np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-300)
+    d = points[index[:, 1:]] - points[:, None, :]
+    along = np.einsum("ijk,ik->ij", d, n)
+    same_side = np.einsum("ijk,ik->ij", n[index[:, 1:]], n) > 0
+    return np.sqrt((np.einsum("ijk,ijk->ij", d, d) - np.where(same_side, along ** 2, 0)).max(axis=1))
 
 
 _BASE = VOXELS + 1

@@ -2,7 +2,8 @@
 
 Each piece (a tile's faces) is kept on disk as it arrives. Only its border vertices can be
 shared with another piece (a face of the neighbouring block meets them there), so only those
-are welded: border vertices of different pieces within the tolerance are one vertex. The tiles
+are welded: two border vertices of different pieces within the tolerance, each the other's
+nearest in its piece, are one vertex (see _weld_pairs for the copies a piece makes itself). The tiles
 compute them from the same lattice corners and samples, but sums over the samples in another
 order (the boundary fit's) can leave them a few millionths of a cell apart near a scan's
 boundary; a hundredth of a cell is far below any edge. The boundary loops of the whole are the
@@ -51,6 +52,30 @@ def trace_loops(edges: np.ndarray) -> List[np.ndarray]:
     return sorted(loops, key=len, reverse=True)
 
 
+def _weld_pairs(at: np.ndarray, piece: np.ndarray, pairs: np.ndarray) -> np.ndarray:
+    """Of the (p, 2) pairs of rows of `at` within the tolerance, those to weld: a vertex and its
+    nearest in another piece when it is that one's nearest in its own (two vertices of one piece
+    can lie closer than the tolerance, at a zero crossing near a lattice corner, and must not
+    become one through a third), and the copies a piece made of one vertex at one position
+    (the filter splits a vertex where the block's edge leaves two fans touching; the
+    neighbouring piece joins them again)."""
+    if len(pairs) == 0:
+        return pairs
+    distance = np.linalg.norm(at[pairs[:, 0]] - at[pairs[:, 1]], axis=1)
+    across = piece[pairs[:, 0]] != piece[pairs[:, 1]]
+    both = np.concatenate([pairs[across], pairs[across][:, ::-1]])
+    d = np.concatenate([distance[across], distance[across]])
+    order = np.lexsort((d, piece[both[:, 1]], both[:, 0]))  # per (row, other piece), nearest first
+    both = both[order]
+    key = both[:, 0] * (int(piece.max()) + 1) + piece[both[:, 1]]
+    first = np.ones(len(both), dtype=bool)
+    first[1:] = key[1:] != key[:-1]
+    nearest = {(int(a), int(b)) for a, b in both[first]}
+    mutual = [(a, b) for a, b in nearest if a < b and (b, a) in nearest]
+    copies = pairs[~across & (distance == 0) & np.isin(pairs[:, 0], both[:, 0])]
+    return np.concatenate([np.array(mutual, dtype=np.int64).reshape(-1, 2), copies])
+
+
 class Join:
     """Pieces added one by one (add), then numbered and welded (finish), then read back
     (arrays) or written (write_ply). tolerance: how close two pieces' border vertices must be
@@ -83,8 +108,7 @@ class Join:
         n = len(local)
         canonical = np.arange(n)
         if n > 1:
-            pairs = cKDTree(at).query_pairs(self.tolerance, output_type="ndarray")
-            pairs = pairs[tile[pairs[:, 0]] != tile[pairs[:, 1]]]  # a piece's own vertices stay apart
+            pairs = _weld_pairs(at, tile, cKDTree(at).query_pairs(self.tolerance, output_type="ndarray"))
             if len(pairs):
                 graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
                 _, label = connected_components(graph, directed=False)
