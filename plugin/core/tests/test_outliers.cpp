@@ -96,6 +96,24 @@ TEST(Outliers, FindsAScatterOfStraysLargerThanAGroupInTheBoxOfASheet)
     EXPECT_EQ(kept.back(), Eigen::Index(surface - 1));
 }
 
+TEST(Outliers, KeepsASampleAloneInAGapOfTheSampling)
+{
+    // A gap 5 spacings wide in a curved sheet (z = x² / 2, grid spacing 0.1) with one sample at
+    // its centre: the samples around the gap have their nearest on their own side, so nobody
+    // claims it, but it lies on their sheet. One just as alone a spacing above it is a stray.
+    std::vector<Eigen::RowVector3d> ps;
+    for (double x = -1; x <= 1.001; x += 0.1)
+        for (double y = -1; y <= 1.001; y += 0.1)
+            if (x * x + y * y > 0.25 * 0.25)
+                ps.emplace_back(x, y, 0.5 * x * x);
+    ps.emplace_back(0, 0, 0);
+    const Points sheet = Stack(ps);
+    EXPECT_EQ(Outliers::Kept(SampleIndex(sheet)).size(), size_t(sheet.rows()));
+    ps.back() = Eigen::RowVector3d(0, 0, 0.1);
+    const Points above = Stack(ps);
+    EXPECT_EQ(Outliers::Kept(SampleIndex(above)).size(), size_t(above.rows() - 1));
+}
+
 TEST(Outliers, KeepsEveryOneOfFewSamples)
 {
     const Points P = Stack({{0, 0, 0}, {1, 0, 0}, {100, 0, 0}});
