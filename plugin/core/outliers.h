@@ -124,6 +124,11 @@ public:
     /// under this fraction only while H is under 0.16 s, on the sheet as far as any tangent
     /// disk (half a slab: 0.32 s) can tell.
     static constexpr double kOnSheet = 0.1;
+    /// ... and when it lies among them: no farther from their centroid than this many times the
+    /// farthest of them. A stray far out in a flat scan's own plane is on their plane too. The
+    /// lone sample of a gap has its nearest on the gap's closest side: up to 1.35 times on the
+    /// cap above.
+    static constexpr double kAmongNeighbours = 2;
 
 private:
     /// Clears keep[i] for the samples of sparse groups, and sparse samples in empty space
@@ -183,7 +188,8 @@ private:
     }
 
     /// Whether sample i lies on the flat sheet of its kNeighbours nearest (kScatter): within
-    /// kOnSheet × reach (the distance to the farthest of them) of their plane.
+    /// kOnSheet × reach (the distance to the farthest of them) of their plane, and among them
+    /// (kAmongNeighbours).
     static bool OnNeighboursSheet(const SampleIndex& samples, Eigen::Index i, double reach, SampleIndex::Queue& queue)
     {
         const Eigen::Vector3d p = samples.P().row(i).transpose();
@@ -202,7 +208,9 @@ private:
         const Eigen::Vector3d lambda = pca.eigenvalues();
         if (!(lambda.sum() > 0) || lambda[0] / lambda.sum() > kScatter)
             return false;
-        return std::abs((p - centroid.transpose()).dot(pca.eigenvectors().col(0))) <= kOnSheet * reach;
+        const Eigen::Vector3d offset = p - centroid.transpose();
+        return std::abs(offset.dot(pca.eigenvectors().col(0))) <= kOnSheet * reach &&
+               offset.norm() <= kAmongNeighbours * centred.rowwise().norm().maxCoeff();
     }
 
     /// The smallest variance of the rows of Q (k×3) about their centroid over the sum of all

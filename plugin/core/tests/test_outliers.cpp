@@ -114,6 +114,17 @@ TEST(Outliers, KeepsASampleAloneInAGapOfTheSampling)
     EXPECT_EQ(Outliers::Kept(SampleIndex(above)).size(), size_t(above.rows() - 1));
 }
 
+TEST(Outliers, FindsAStrayFarAwayInTheSheetsOwnPlane)
+{
+    // A flat scan and one sample ten times its size away along its own plane: on the plane
+    // its neighbours span, but nowhere among them.
+    std::vector<Eigen::RowVector3d> ps = UnevenPlane();
+    const size_t surface = ps.size();
+    ps.emplace_back(40, 40, 0);
+    const Points P = Stack(ps);
+    EXPECT_EQ(Outliers::Kept(SampleIndex(P)).size(), surface);
+}
+
 TEST(Outliers, KeepsEveryOneOfFewSamples)
 {
     const Points P = Stack({{0, 0, 0}, {1, 0, 0}, {100, 0, 0}});
