@@ -116,7 +116,7 @@ TEST(Outliers, KeepsASampleAloneInAGapOfTheSampling)
 
 TEST(Outliers, FindsAStrayFarAwayInTheSheetsOwnPlane)
 {
-    // A flat scan and one sample ten times its size away along its own plane: on the plane
+    // A flat scan and one sample about ten times its size away in its own plane: on the plane
     // its neighbours span, but nowhere among them.
     std::vector<Eigen::RowVector3d> ps = UnevenPlane();
     const size_t surface = ps.size();
