@@ -82,12 +82,10 @@ def main(argv=None):
     rows, kinds = [], {}
     for name, kind, points, normals, faces in cases(args.seed):
         kinds[name] = kind
-        clean_seconds = None
         for condition in args.conditions:
             rng = np.random.default_rng(len(points) + args.seed)
-            row = measure(name, condition, points, normals, faces, rng, params, clean_seconds)
-            if condition == "clean":
-                clean_seconds = row["seconds"]
+            row = measure(name, condition, points, normals, faces, rng, params,
+                          condition != "clean" and "clean" in args.conditions)
             rows.append(row)
             mark = "" if row["loops"] == row["true"] else " ✗"
             print(f"| {name} | {kind} | {condition} | {row['samples']} | {row['loops']} / {row['true']}{mark} "
