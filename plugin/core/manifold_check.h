@@ -28,8 +28,15 @@ public:
     {
         using Clean = vcg::tri::Clean<CoreMesh>;
         Result r;
-        vcg::tri::UpdateTopology<CoreMesh>::FaceFace(mesh);
+        // Ours, not VCG's sorted edge list: the same adjacency on an edge-manifold mesh at a
+        // fraction of the time (the sort was 4% of a 300,000-sample run). An edge of three or
+        // more faces still shows: one of them is not linked back (vcg::face::IsManifold). It
+        // walks every face, deleted or not: compact first.
+        if (mesh.fn != int(mesh.face.size()) || mesh.vn != int(mesh.vert.size()))
+            vcg::tri::Allocator<CoreMesh>::CompactEveryVector(mesh);
+        UpdateFaceFace(mesh);
         if (NonManifoldEdges(mesh) > 0) {
+            vcg::tri::UpdateTopology<CoreMesh>::FaceFace(mesh);  // the face rings the removal walks
             r.faces_removed = size_t(Clean::RemoveNonManifoldFace(mesh));
             vcg::tri::Allocator<CoreMesh>::CompactEveryVector(mesh);
             vcg::tri::UpdateTopology<CoreMesh>::FaceFace(mesh);
