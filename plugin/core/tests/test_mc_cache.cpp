@@ -126,3 +126,42 @@ TEST(MarchingCubesWalker, EdgeVerticesAreSharedWhateverTheCellOrder)
     for (const Eigen::Vector3d& p : a)
         EXPECT_LT(std::abs(p.norm() - r), 0.05 * l.cell_size);
 }
+
+TEST(KeyTable, KeepsEveryKeysValueAcrossGrowthAndFindsNoOther)
+{
+    KeyTable<size_t> table;
+    EXPECT_EQ(table.Find(PackIndex(0, 0, 0)), KeyTable<size_t>::kNone);  // empty: no slots yet
+    // Lattice keys in a slab, far more than the first 1,024 slots: the table grows several times.
+    std::vector<uint64_t> keys;
+    for (int z = 0; z < 4; ++z)
+        for (int y = 0; y < 60; ++y)
+            for (int x = 0; x < 60; ++x)
+                keys.push_back(PackIndex(x, y, z));
+    for (size_t i = 0; i < keys.size(); ++i) {
+        bool inserted;
+        table.At(table.Insert(keys[i], inserted)) = i;
+        EXPECT_TRUE(inserted);
+    }
+    EXPECT_EQ(table.Size(), keys.size());
+    EXPECT_LE(double(table.Size()), 0.7 * double(table.Slots()));
+    for (size_t i = 0; i < keys.size(); ++i) {
+        bool inserted;
+        const size_t s = table.Insert(keys[i], inserted);  // already there: the same slot
+        EXPECT_FALSE(inserted);
+        EXPECT_EQ(s, table.Find(keys[i]));
+        EXPECT_EQ(table.At(s), i);
+    }
+    EXPECT_EQ(table.Find(PackIndex(60, 0, 0)), KeyTable<size_t>::kNone);
+    EXPECT_EQ(table.Find(PackIndex(0, 0, 4)), KeyTable<size_t>::kNone);
+
+    // With room reserved, slots stay where they were given while new keys go in.
+    table.Reserve(5000);
+    const size_t slots = table.Slots(), first = table.Find(keys[0]);
+    for (int x = 0; x < 5000; ++x) {
+        bool inserted;
+        table.Insert(PackIndex(x, 0, 9), inserted);
+    }
+    EXPECT_EQ(table.Slots(), slots);
+    EXPECT_EQ(table.Find(keys[0]), first);
+    EXPECT_EQ(table.Size(), keys.size() + 5000);
+}
