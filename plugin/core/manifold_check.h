@@ -35,17 +35,21 @@ public:
         if (mesh.fn != int(mesh.face.size()) || mesh.vn != int(mesh.vert.size()))
             vcg::tri::Allocator<CoreMesh>::CompactEveryVector(mesh);
         UpdateFaceFace(mesh);
-        if (NonManifoldEdges(mesh) > 0) {
+        const bool edgesBad = NonManifoldEdges(mesh) > 0;
+        if (edgesBad) {
             vcg::tri::UpdateTopology<CoreMesh>::FaceFace(mesh);  // the face rings the removal walks
             r.faces_removed = size_t(Clean::RemoveNonManifoldFace(mesh));
             vcg::tri::Allocator<CoreMesh>::CompactEveryVector(mesh);
             vcg::tri::UpdateTopology<CoreMesh>::FaceFace(mesh);
         }
-        if (Clean::CountNonManifoldVertexFF(mesh, false, false) > 0) {
+        const bool verticesBad = Clean::CountNonManifoldVertexFF(mesh, false, false) > 0;
+        if (verticesBad) {
             r.vertices_split = size_t(Clean::SplitNonManifoldVertex(mesh, 0));
             vcg::tri::UpdateTopology<CoreMesh>::FaceFace(mesh);
         }
-        r.manifold = NonManifoldEdges(mesh) == 0 && Clean::CountNonManifoldVertexFF(mesh, false, false) == 0;
+        // Counted again only after a repair (each count walks every face).
+        r.manifold = (!edgesBad && !verticesBad) ||
+                     (NonManifoldEdges(mesh) == 0 && Clean::CountNonManifoldVertexFF(mesh, false, false) == 0);
         r.oriented = Clean::IsCoherentlyOrientedMesh(mesh);
         return r;
     }
