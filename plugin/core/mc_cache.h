@@ -17,6 +17,7 @@
 
 #include <algorithm>
 #include <array>
+#include <stdexcept>
 #include <vector>
 
 namespace ib {
@@ -168,8 +169,12 @@ public:
     /// The value at the corner with this key, which must have been evaluated.
     double operator()(uint64_t key) const
     {
-        if (dense_.empty())
-            return table_.At(table_.Find(key));
+        if (dense_.empty()) {
+            const size_t slot = table_.Find(key);
+            if (slot == KeyTable<double>::kNone)  // a bug, but not one to crash the host over
+                throw std::logic_error("a lattice corner was read before it was evaluated");
+            return table_.At(slot);
+        }
         return dense_[DenseIndex(key)];
     }
 

@@ -7,6 +7,7 @@
 
 #include <atomic>
 #include <set>
+#include <stdexcept>
 
 using namespace ib;
 
@@ -164,4 +165,15 @@ TEST(KeyTable, KeepsEveryKeysValueAcrossGrowthAndFindsNoOther)
     EXPECT_EQ(table.Slots(), slots);
     EXPECT_EQ(table.Find(keys[0]), first);
     EXPECT_EQ(table.Size(), keys.size() + 5000);
+}
+
+TEST(CornerValues, ACornerReadBeforeItsEvaluationThrows)
+{
+    const Lattice l = Lattice::Fit(Eigen::Vector3d(-1, -1, -1), Eigen::Vector3d(1, 1, 1), 16, 2);
+    const CountingSphere f;
+    CornerValues values(l, f);
+    EXPECT_THROW(values(PackIndex(0, 0, 0)), std::logic_error);  // nothing evaluated yet
+    values.Evaluate({Index3(0, 0, 0)});
+    EXPECT_NO_THROW(values(PackIndex(1, 1, 1)));
+    EXPECT_THROW(values(PackIndex(2, 0, 0)), std::logic_error);  // not a corner of that cell
 }
