@@ -20,10 +20,13 @@
 /// Sign convention (implicit_function.h): negative inside (against the face normals).
 ///
 /// The same closest-point query tells how far a point lies past an open mesh's border
-/// (PastBorder), which keeps an input mesh's holes open (mesh_holes.h).
+/// (PastBorder), which keeps an input mesh's holes open (mesh_holes.h). Most points asked are
+/// nowhere near a border, and those are answered without the closest-point search: see
+/// NearBorder.
 
 #include "implicit_function.h"
 #include "../parallel.h"
+#include "../samples.h"
 
 #include <vcg/complex/complex.h>
 #include <vcg/complex/algorithms/clean.h>
@@ -32,7 +35,10 @@
 #include <vcg/complex/algorithms/update/topology.h>
 #include <vcg/space/index/grid_static_ptr.h>
 
+#include <algorithm>
+#include <memory>
 #include <stdexcept>
+#include <vector>
 
 namespace ib {
 
@@ -105,6 +111,7 @@ public:
         vcg::tri::UpdateNormal<DistanceMesh>::NormalizePerVertex(mesh_);
         vcg::tri::UpdateBounding<DistanceMesh>::Box(mesh_);
         grid_.Set(mesh_.face.begin(), mesh_.face.end());
+        IndexBorder();
         maxDistance_ = std::max(1.0, 1e6 * mesh_.bbox.Diag());
     }
 
@@ -126,9 +133,11 @@ public:
     {
         Eigen::VectorXd past(Q.rows());
         ParallelFor(size_t(Q.rows()), threads_, [&](size_t begin, size_t end, int) {
-            for (size_t i = begin; i < end; ++i)
-                past[Eigen::Index(i)] =
-                    PastBorderOne(vcg::Point3d(Q(Eigen::Index(i), 0), Q(Eigen::Index(i), 1), Q(Eigen::Index(i), 2)));
+            SampleIndex::Queue queue;
+            for (size_t i = begin; i < end; ++i) {
+                const Eigen::Vector3d p = Q.row(Eigen::Index(i)).transpose();
+                past[Eigen::Index(i)] = NearBorder(p, queue) ? PastBorderOne(vcg::Point3d(p[0], p[1], p[2])) : 0;
+            }
         }, 256);
         return past;
     }
@@ -173,6 +182,55 @@ private:
         return grid_.GetClosest(distance, noMarks, p, maxDistance_, d, q);
     }
 
+    /// Points along the border edges at most borderStep_ apart, ends included, and the indices
+    /// of the mesh's vertices and of those points.
+    void IndexBorder()
+    {
+        std::vector<double> lengths;
+        for (const DistanceFace& f : mesh_.face)
+            for (int e = 0; e < 3; ++e)
+                lengths.push_back(vcg::Distance(f.cP(e), f.cP((e + 1) % 3)));
+        std::nth_element(lengths.begin(), lengths.begin() + lengths.size() / 2, lengths.end());
+        borderStep_ = lengths[lengths.size() / 2];
+        std::vector<Eigen::RowVector3d> along;
+        for (const DistanceFace& f : mesh_.face)
+            for (int e = 0; e < 3; ++e) {
+                if (!f.IsB(e))
+                    continue;
+                const vcg::Point3d a = f.cP(e), b = f.cP((e + 1) % 3);
+                const int pieces = std::max(1, int(std::ceil(vcg::Distance(a, b) / borderStep_)));
+                for (int k = 0; k <= pieces; ++k) {
+                    const vcg::Point3d q = a + (b - a) * (double(k) / pieces);
+                    along.emplace_back(q[0], q[1], q[2]);
+                }
+            }
+        if (along.empty())
+            return;
+        borderPoints_.resize(Eigen::Index(along.size()), 3);
+        for (size_t i = 0; i < along.size(); ++i)
+            borderPoints_.row(Eigen::Index(i)) = along[i];
+        vertices_.resize(Eigen::Index(mesh_.vert.size()), 3);
+        for (size_t i = 0; i < mesh_.vert.size(); ++i)
+            vertices_.row(Eigen::Index(i)) << mesh_.vert[i].cP()[0], mesh_.vert[i].cP()[1], mesh_.vert[i].cP()[2];
+        borderIndex_ = std::make_unique<SampleIndex>(borderPoints_);
+        vertexIndex_ = std::make_unique<SampleIndex>(vertices_);
+    }
+
+    /// Whether p's closest point on the mesh could lie on its border. That point is no farther
+    /// from p than p's nearest vertex, and a border point lies within half a step of it, so a
+    /// point whose nearest border point is farther than that, plus half a step, is over the
+    /// mesh inside its border: PastBorderOne would find 0.
+    bool NearBorder(const Eigen::Vector3d& p, SampleIndex::Queue& queue) const
+    {
+        if (!borderIndex_)
+            return false;
+        vertexIndex_->Nearest(p, 1, queue);
+        const double vertex = std::sqrt(queue.getWeight(0));
+        borderIndex_->Nearest(p, 1, queue);
+        const double border = std::sqrt(queue.getWeight(0));
+        return border <= vertex + 0.5 * borderStep_ * (1 + 1e-9) + 1e-12 * maxDistance_;
+    }
+
     double PastBorderOne(const vcg::Point3d& p) const
     {
         double d;
@@ -211,6 +269,9 @@ private:
     }
 
     DistanceMesh mesh_;
+    Points vertices_, borderPoints_;                       // for NearBorder; empty when closed
+    std::unique_ptr<SampleIndex> vertexIndex_, borderIndex_;
+    double borderStep_ = 0;
     // VCG's grid queries are not const but only read the grid (no marks with EmptyTMark).
     mutable vcg::GridStaticPtr<DistanceFace, double> grid_;
     double maxDistance_ = 1;

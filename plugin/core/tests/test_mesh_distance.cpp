@@ -139,3 +139,44 @@ TEST(MeshDistance, PastBorderIsTheInPlaneDistanceBeyondAnOpenEdge)
     test::Icosphere(S, T, 2);
     EXPECT_EQ(MeshDistance(S, T).PastBorder(Shell(200, 1.5, 3)).maxCoeff(), 0);
 }
+
+TEST(MeshDistance, PastBorderIsTheInPlaneDistanceToAPlaneWithAHole)
+{
+    // A 10 x 10 grid of unit squares in z = 0 without its 2 x 2 middle squares: the region
+    // [0, 10]^2 less (4, 6)^2. Its closest point to p is the region's closest point to p's
+    // (x, y), on the border when (x, y) is outside the region; PastBorder is their distance.
+    // Points over the inside far from any border are answered without the closest-point
+    // search, those near it by the search: both must agree with the plane's geometry.
+    CoreMesh grid;
+    test::Grid(10, 1.0, grid);
+    for (CoreMesh::FaceType& f : grid.face) {
+        const vcg::Point3d c = vcg::Barycenter(f);
+        if (c[0] > 4 && c[0] < 6 && c[1] > 4 && c[1] < 6)
+            vcg::tri::Allocator<CoreMesh>::DeleteFace(grid, f);
+    }
+    vcg::tri::Allocator<CoreMesh>::CompactEveryVector(grid);
+    Points V;
+    Faces F;
+    test::Matrices(grid, V, F);
+    const MeshDistance plane(V, F);
+
+    std::srand(7);
+    const int n = 4000;
+    Points Q(n, 3);
+    Eigen::VectorXd expected(n);
+    for (int i = 0; i < n; ++i) {
+        const Eigen::Vector3d r = Eigen::Vector3d::Random();  // in [-1, 1]^3
+        const double x = 5 + 7 * r[0], y = 5 + 7 * r[1];
+        Q.row(i) << x, y, 0.8 * r[2];
+        const double outside = std::hypot(std::max({0.0, -x, x - 10}), std::max({0.0, -y, y - 10}));
+        const bool inHole = x > 4 && x < 6 && y > 4 && y < 6;
+        expected[i] = inHole ? std::min({x - 4, 6 - x, y - 4, 6 - y}) : outside;
+    }
+    const Eigen::VectorXd past = plane.PastBorder(Q);
+    int over = 0;
+    for (int i = 0; i < n; ++i) {
+        EXPECT_NEAR(past[i], expected[i], 1e-9) << "at " << Q.row(i);
+        over += expected[i] == 0;
+    }
+    EXPECT_GT(over, n / 4);  // many points are over the plane, inside its border
+}
