@@ -168,7 +168,8 @@ public:
     /// loops of 18 edges, which the trim then peeled open. Or, with `coverage` (the samples of
     /// merged scans, their local `spacing`; null: no such rule), none of it is
     /// farther than kCoverageGap spacings from them, or, with `mesh` (the input's triangles;
-    /// null: none), all of it lies over them (MeshHoles::Covered, on a lattice of `cellSize`).
+    /// null: none), all of it lies over them and near them (MeshHoles::Covered, on a lattice of
+    /// `cellSize`, within kNearTriangles local spacings of `local`).
     /// Also reports the edge counts of all loops and, in `margins` (may be null),
     /// largest_hole_filled and smallest_hole_kept.
     static std::vector<int> SmallHoles(const CoreMesh& all, const std::vector<char>& inSurface,
@@ -215,7 +216,7 @@ public:
         }
         if (mesh) {
             const std::vector<char> covered =
-                MeshHoles::Covered(all, mc.surface_faces, mc.face_region, candidate, *mesh, cellSize);
+                MeshHoles::Covered(all, mc.surface_faces, mc.face_region, candidate, *mesh, cellSize, local, &spacing);
             for (size_t i = 0; i < fill.size(); ++i)
                 fill[i] = fill[i] || covered[i];
         }

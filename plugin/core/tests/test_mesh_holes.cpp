@@ -134,3 +134,34 @@ TEST(MeshHoles, CoveredTellsHoleRegionsOverTheMeshFromThosePastItsBorder)
     EXPECT_EQ(MeshHoles::Covered(all, 0, region, {0, 1, 1}, square, 0.05), (std::vector<char>{0, 0, 0}))
         << "only the regions asked about";
 }
+
+TEST(MeshHoles, CoveredLeavesOpenAHoleWhoseFacesBalloonAwayFromTheMesh)
+{
+    // The input: the unit square in z = 0, sampled every 0.1. The extraction: hole faces over
+    // it (x, y < 0.9), region 0 at z = 0.1 (one spacing above the square), region 1 at z = 0.3
+    // (three: a fill that balloons away from the triangles), region 2 the slope between them;
+    // region 3 reaches past the square's border. Only region 0 fills the square's surface.
+    Points V;
+    Faces F;
+    test::UnitSquare(V, F);
+    const MeshDistance square(V, F);
+    Points samples(121, 3);
+    for (int j = 0, k = 0; j <= 10; ++j)
+        for (int i = 0; i <= 10; ++i, ++k)
+            samples.row(k) << 0.1 * i, 0.1 * j, 0;
+    const SampleIndex index(samples);
+    const Eigen::VectorXd spacing = Eigen::VectorXd::Constant(samples.rows(), 0.1);
+    CoreMesh all;
+    test::Grid(30, 0.05, all);
+    for (CoreVertex& v : all.vert)
+        v.P()[2] = v.P()[1] < 0.42 ? 0.1 : v.P()[1] > 0.58 ? 0.3 : 0.1 + 0.2 * (v.P()[1] - 0.42) / 0.16;
+    std::vector<int> region;
+    for (const CoreFace& f : all.face) {
+        const vcg::Point3d c = vcg::Barycenter(f);
+        region.push_back(c[0] > 0.9 || c[1] > 0.9 ? 3 : c[1] < 0.4 ? 0 : c[1] > 0.6 ? 1 : 2);
+    }
+    EXPECT_EQ(MeshHoles::Covered(all, 0, region, {1, 1, 1, 1}, square, 0.05, &index, &spacing),
+              (std::vector<char>{1, 0, 0, 0}));
+    EXPECT_EQ(MeshHoles::Covered(all, 0, region, {1, 1, 1, 1}, square, 0.05), (std::vector<char>{1, 1, 1, 0}))
+        << "without the samples, only over the triangles is asked";
+}
