@@ -35,8 +35,9 @@ public:
     /// the face) from the triangles is not filled with its hole faces: no face of the surface
     /// should stray farther from the true one (docs/yardsticks.md, farthest face). Measured on
     /// every input given as a mesh (bench/corpus.py and bench/held_out.py, --conditions mesh):
-    /// the hole regions over the triangles reach 1.18, 1.48 and 2.31 spacings from them, and
-    /// 9.01 where the implicit surface closed the cow's ear, a flap a triangle thick, as a ball.
+    /// the only hole regions over the triangles, four on a cut cow, reach 1.18, 1.48 and 2.31
+    /// spacings from them, and 9.01 where the implicit surface closed its ear, a flap a
+    /// triangle thick, as a ball.
     static constexpr double kNearTriangles = 2.0;
 
     /// Per hole region of `all` with regions[r] set (its hole faces are all.face[surfaceFaces +
