@@ -216,7 +216,8 @@ public:
         }
         if (mesh) {
             const std::vector<char> covered =
-                MeshHoles::Covered(all, mc.surface_faces, mc.face_region, candidate, *mesh, cellSize, local, &spacing);
+                MeshHoles::Covered(all, mc.surface_faces, mc.face_region, candidate, *mesh, cellSize, local, &spacing,
+                                   threads);
             for (size_t i = 0; i < fill.size(); ++i)
                 fill[i] = fill[i] || covered[i];
         }

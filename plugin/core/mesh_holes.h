@@ -43,10 +43,11 @@ public:
     /// Per hole region of `all` with regions[r] set (its hole faces are all.face[surfaceFaces +
     /// i] with faceRegion[i] == r), 1 if the centre of each of its faces lies over `input` (at
     /// most kPastBorderCells × cellSize past its border) and, with `samples` (and `spacing`,
-    /// their local spacings), within kNearTriangles local spacings of it.
+    /// their local spacings), within kNearTriangles local spacings of it (`threads`: 0 = all cores).
     static std::vector<char> Covered(const CoreMesh& all, size_t surfaceFaces, const std::vector<int>& faceRegion,
                                      const std::vector<char>& regions, const MeshDistance& input, double cellSize,
-                                     const SampleIndex* samples = nullptr, const Eigen::VectorXd* spacing = nullptr)
+                                     const SampleIndex* samples = nullptr, const Eigen::VectorXd* spacing = nullptr,
+                                     int threads = 0)
     {
         std::vector<size_t> faces;
         for (size_t i = 0; i < faceRegion.size(); ++i)
@@ -63,14 +64,26 @@ public:
             if (past[Eigen::Index(k)] > kPastBorderCells * cellSize)
                 covered[size_t(faceRegion[faces[k]])] = 0;
         if (samples && spacing) {
-            Eigen::VectorXd distance(centres.rows());
-            input.Eval(centres, distance);
-            SampleIndex::Queue queue;
-            for (size_t k = 0; k < faces.size(); ++k) {
-                samples->Nearest(centres.row(Eigen::Index(k)).transpose(), 1, queue);
-                if (std::abs(distance[Eigen::Index(k)]) > kNearTriangles * (*spacing)[queue.getIndex(0)])
-                    covered[size_t(faceRegion[faces[k]])] = 0;
-            }
+            // Only the faces of regions still covered: a region's outer faces past the border
+            // (a scan's unseen surround) would cost most of the closest-point queries.
+            std::vector<size_t> left;
+            for (size_t k = 0; k < faces.size(); ++k)
+                if (covered[size_t(faceRegion[faces[k]])])
+                    left.push_back(k);
+            const Points near = centres(left, Eigen::all);
+            Eigen::VectorXd distance(near.rows());
+            input.Eval(near, distance);
+            std::vector<char> far(left.size(), 0);
+            ParallelFor(left.size(), threads, [&](size_t begin, size_t end, int) {
+                SampleIndex::Queue queue;
+                for (size_t j = begin; j < end; ++j) {
+                    samples->Nearest(near.row(Eigen::Index(j)).transpose(), 1, queue);
+                    far[j] = std::abs(distance[Eigen::Index(j)]) > kNearTriangles * (*spacing)[queue.getIndex(0)];
+                }
+            }, 256);
+            for (size_t j = 0; j < left.size(); ++j)
+                if (far[j])
+                    covered[size_t(faceRegion[faces[left[j]]])] = 0;
         }
         return covered;
     }

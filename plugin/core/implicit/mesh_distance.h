@@ -22,7 +22,7 @@
 /// The same closest-point query tells how far a point lies past an open mesh's border
 /// (PastBorder), which keeps an input mesh's holes open (mesh_holes.h). Most points asked are
 /// nowhere near a border, and those are answered without the closest-point search: see
-/// NearBorder.
+/// BorderMargin.
 
 #include "implicit_function.h"
 #include "../parallel.h"
@@ -36,6 +36,7 @@
 #include <vcg/space/index/grid_static_ptr.h>
 
 #include <algorithm>
+#include <limits>
 #include <memory>
 #include <stdexcept>
 #include <vector>
@@ -134,9 +135,20 @@ public:
         Eigen::VectorXd past(Q.rows());
         ParallelFor(size_t(Q.rows()), threads_, [&](size_t begin, size_t end, int) {
             SampleIndex::Queue queue;
+            // Points asked in a row usually lie close together (faces of neighbouring cells):
+            // the last point tested stands for every point within half its margin.
+            Eigen::Vector3d tested = Eigen::Vector3d::Zero();
+            double reach = -1;
             for (size_t i = begin; i < end; ++i) {
                 const Eigen::Vector3d p = Q.row(Eigen::Index(i)).transpose();
-                past[Eigen::Index(i)] = NearBorder(p, queue) ? PastBorderOne(vcg::Point3d(p[0], p[1], p[2])) : 0;
+                if (reach > 0 && (p - tested).squaredNorm() < reach * reach) {
+                    past[Eigen::Index(i)] = 0;
+                    continue;
+                }
+                const double margin = BorderMargin(p, queue);
+                past[Eigen::Index(i)] = margin > 0 ? 0 : PastBorderOne(vcg::Point3d(p[0], p[1], p[2]));
+                tested = p;
+                reach = 0.5 * margin;
             }
         }, 256);
         return past;
@@ -216,19 +228,22 @@ private:
         vertexIndex_ = std::make_unique<SampleIndex>(vertices_);
     }
 
-    /// Whether p's closest point on the mesh could lie on its border. That point is no farther
-    /// from p than p's nearest vertex, and a border point lies within half a step of it, so a
-    /// point whose nearest border point is farther than that, plus half a step, is over the
-    /// mesh inside its border: PastBorderOne would find 0.
-    bool NearBorder(const Eigen::Vector3d& p, SampleIndex::Queue& queue) const
+    /// How far p's closest point on the mesh is from possibly lying on its border. That point
+    /// is no farther from p than p's nearest vertex, and every point of the border lies within
+    /// half a step of one of the points indexed along it, so when p's nearest indexed border
+    /// point is farther than its nearest vertex plus half a step, p is over the mesh inside its
+    /// border (PastBorderOne would find 0) and the margin, the difference, is positive. Moving
+    /// p by d changes both distances by at most d, so the points within half the margin of p
+    /// are inside too. Infinite for a closed mesh; zero or negative near the border.
+    double BorderMargin(const Eigen::Vector3d& p, SampleIndex::Queue& queue) const
     {
         if (!borderIndex_)
-            return false;
+            return std::numeric_limits<double>::infinity();
         vertexIndex_->Nearest(p, 1, queue);
         const double vertex = std::sqrt(queue.getWeight(0));
         borderIndex_->Nearest(p, 1, queue);
         const double border = std::sqrt(queue.getWeight(0));
-        return border <= vertex + 0.5 * borderStep_ * (1 + 1e-9) + 1e-12 * maxDistance_;
+        return border - (vertex + 0.5 * borderStep_ * (1 + 1e-9) + 1e-12 * maxDistance_);
     }
 
     double PastBorderOne(const vcg::Point3d& p) const
@@ -269,7 +284,7 @@ private:
     }
 
     DistanceMesh mesh_;
-    Points vertices_, borderPoints_;                       // for NearBorder; empty when closed
+    Points vertices_, borderPoints_;                       // for BorderMargin; empty when closed
     std::unique_ptr<SampleIndex> vertexIndex_, borderIndex_;
     double borderStep_ = 0;
     // VCG's grid queries are not const but only read the grid (no marks with EmptyTMark).
