@@ -179,4 +179,21 @@ TEST(MeshDistance, PastBorderIsTheInPlaneDistanceToAPlaneWithAHole)
         over += expected[i] == 0;
     }
     EXPECT_GT(over, n / 4);  // many points are over the plane, inside its border
+
+    // The same, asked row by row across a lattice, as the faces of marching cubes come: each
+    // point is near the one before, so most are answered by an earlier point's margin.
+    const int side = 141;  // x, y from -2 to 12, 0.1 apart
+    Points R(side * side, 3);
+    Eigen::VectorXd rowExpected(R.rows());
+    for (int j = 0; j < side; ++j)
+        for (int i = 0; i < side; ++i) {
+            const double x = -2 + 0.1 * i, y = -2 + 0.1 * j;
+            R.row(j * side + i) << x, y, 0.3;
+            const double outside = std::hypot(std::max({0.0, -x, x - 10}), std::max({0.0, -y, y - 10}));
+            const bool inHole = x > 4 && x < 6 && y > 4 && y < 6;
+            rowExpected[j * side + i] = inHole ? std::min({x - 4, 6 - x, y - 4, 6 - y}) : outside;
+        }
+    const Eigen::VectorXd rowPast = plane.PastBorder(R);
+    for (Eigen::Index i = 0; i < R.rows(); ++i)
+        EXPECT_NEAR(rowPast[i], rowExpected[i], 1e-9) << "at " << R.row(i);
 }
