@@ -14,6 +14,7 @@
 #include "manifold_check.h"
 #include "memory_budget.h"
 #include "normals.h"
+#include "open_sides.h"
 #include "orientation_seam.h"
 #include "outliers.h"
 #include "progress.h"
@@ -53,6 +54,10 @@ public:
     /// slab from that spacing closed the smallest real holes of bun_zipper, fertility and
     /// pymeshlab's bunny.
     static constexpr double kSlabPerSpacing = kCellPerSpacing * (0.5 + kDiskSlack) / M_SQRT2;
+    /// Where the sampling ends (OpenSides), a tangent disk reaches this many of its sample's
+    /// local spacings past it: the surface's own edge lies about half a spacing beyond its last
+    /// samples, and the boundary trim and fit place the boundary from there.
+    static constexpr double kOpenMargin = 0.0;
 
     using Param = ReconstructionParam;
     using NormalSource = Param::NormalSource;
@@ -200,7 +205,9 @@ private:
                         ? Sods::FromDisks(lattice, ImplicitProjection::OntoZeroSet(P, normals, f), normals,
                                           p.sample_radius * spacing, kDiskSlack * lattice.cell_size, p.threads,
                                           0.5 * foldWidth,
-                                          kSlabPerSpacing * spacing, kCellPerSpacing * r.sample_spacing)
+                                          kSlabPerSpacing * spacing, kCellPerSpacing * r.sample_spacing,
+                                          OpenSides::Compute(samples, normals, p.sample_radius * spacing, p.threads),
+                                          kOpenMargin * spacing)
                         : Sods::FromSamples(lattice, P);
         for (int i = 0; i < p.sods_dilation; ++i)
             sods = sods.Dilated();
