@@ -54,10 +54,6 @@ public:
     /// slab from that spacing closed the smallest real holes of bun_zipper, fertility and
     /// pymeshlab's bunny.
     static constexpr double kSlabPerSpacing = kCellPerSpacing * (0.5 + kDiskSlack) / M_SQRT2;
-    /// Where the sampling ends (OpenSides), a tangent disk reaches this many of its sample's
-    /// local spacings past it: the surface's own edge lies about half a spacing beyond its last
-    /// samples, and the boundary trim and fit place the boundary from there.
-    static constexpr double kOpenMargin = 0.0;
 
     using Param = ReconstructionParam;
     using NormalSource = Param::NormalSource;
@@ -199,15 +195,17 @@ private:
         // automatic cell's reach, as the random gaps between samples, no longer bridged by the
         // cells, opened as holes. (A reach from each sample's own spacing, not the median,
         // closed the smallest real holes of bun_zipper and fertility: samples at a hole's rim
-        // have one-sided neighbourhoods, so larger spacings.)
+        // have one-sided neighbourhoods, so larger spacings.) Where the sampling ends (a scan's
+        // edge, a thin tube's open end) a disk covers only its half behind its sample
+        // (OpenSides): at halftunnel's countersunk hole, without normals, the full disks of its
+        // rim, whose estimated planes lean 25 degrees over the opening, capped it.
         const Eigen::VectorXd foldWidth = OrientationSeam::FoldWidths(samples, normals, spacing, p.threads, scan);
         Sods sods = p.sods_occupancy == Occupancy::TangentDisks
                         ? Sods::FromDisks(lattice, ImplicitProjection::OntoZeroSet(P, normals, f), normals,
                                           p.sample_radius * spacing, kDiskSlack * lattice.cell_size, p.threads,
                                           0.5 * foldWidth,
                                           kSlabPerSpacing * spacing, kCellPerSpacing * r.sample_spacing,
-                                          OpenSides::Compute(samples, normals, p.sample_radius * spacing, p.threads),
-                                          kOpenMargin * spacing)
+                                          OpenSides::Compute(samples, normals, p.sample_radius * spacing, p.threads))
                         : Sods::FromSamples(lattice, P);
         for (int i = 0; i < p.sods_dilation; ++i)
             sods = sods.Dilated();

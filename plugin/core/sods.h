@@ -42,11 +42,12 @@ public:
     /// it has on cells of reachCell. With radii from the local sample spacing, sparse regions
     /// stay covered while gaps wider than two radii stay open. Where open.row(i) is a nonzero unit
     /// vector in the tangent plane (open: n×3, or empty for none; OpenSides), the sampling ends
-    /// that way and disk i covers only its part within openMargin[i] ahead along it.
+    /// that way and disk i covers only its half behind its sample (cells whose centre lies at
+    /// most half a cell diagonal ahead).
     static Sods FromDisks(const Lattice& lattice, const Points& P, const Points& N, const Eigen::VectorXd& radius,
                           double slack, int threads = 0, const Eigen::VectorXd& thickness = Eigen::VectorXd(),
                           const Eigen::VectorXd& minSlab = Eigen::VectorXd(), double reachCell = 0,
-                          const Points& open = Points(), const Eigen::VectorXd& openMargin = Eigen::VectorXd())
+                          const Points& open = Points())
     {
         // One occupancy per block of samples, OR-ed together: the result does not depend on
         // the thread count.
@@ -60,8 +61,7 @@ public:
                     parts[b].InsertDisk(lattice, P.row(i).transpose(), N.row(i).transpose(), radius[i],
                                         slack, thickness.size() ? thickness[i] : 0.0,
                                         minSlab.size() ? minSlab[i] : 0.0, reachCell,
-                                        open.rows() ? Eigen::Vector3d(open.row(i).transpose()) : Eigen::Vector3d::Zero(),
-                                        openMargin.size() ? openMargin[i] : 0.0);
+                                        open.rows() ? Eigen::Vector3d(open.row(i).transpose()) : Eigen::Vector3d::Zero());
         }, 1);
         for (size_t b = 1; b < parts.size(); ++b)
             parts[0].Merge(parts[b]);
@@ -84,13 +84,13 @@ public:
     /// Adds the cells of one tangent disk (see FromDisks; `open` zero: the whole disk).
     void InsertDisk(const Lattice& lattice, const Eigen::Vector3d& p, const Eigen::Vector3d& n, double r, double slack,
                     double thickness = 0, double minSlab = 0, double reachCell = 0,
-                    const Eigen::Vector3d& open = Eigen::Vector3d::Zero(), double openMargin = 0)
+                    const Eigen::Vector3d& open = Eigen::Vector3d::Zero())
     {
         const double a = 0.5 * lattice.cell_size;
         const double wider = std::max(1.0, reachCell / lattice.cell_size);
         const double slab = std::max(a * n.cwiseAbs().sum() + slack, minSlab) + thickness;
         const double reach = r + wider * a * std::sqrt(3.0);
-        const double openReach = open.isZero() ? reach : openMargin + wider * a * std::sqrt(3.0);
+        const double openReach = open.isZero() ? reach : wider * a * std::sqrt(3.0);
         const Eigen::Vector3d box =
             Eigen::Vector3d::Constant(std::max(r + (wider - 1) * a * std::sqrt(3.0), std::max(slack, minSlab) + thickness));
         const Index3 lo = lattice.CellOf(p - box), hi = lattice.CellOf(p + box);

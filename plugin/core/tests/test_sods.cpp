@@ -87,20 +87,18 @@ TEST(Sods, TangentDiskCoversItsPlaneOnly)
 
 TEST(Sods, AnOpenDiskStopsAtItsMarginAhead)
 {
-    // The disk of TangentDiskCoversItsPlaneOnly, open towards +x with a margin of 0.5: ahead it
-    // reaches 0.5 + half a cell diagonal (cell centres up to x = 6.87), behind and sideways
-    // its full radius.
+    // The disk of TangentDiskCoversItsPlaneOnly, open towards +x: ahead it reaches half a cell
+    // diagonal (cell centres up to x = 6.37), behind and sideways its full radius.
     Points P(1, 3), N(1, 3), open(1, 3);
     P << 5.5, 5.5, 5.5;
     N << 0, 0, 1;
     open << 1, 0, 0;
     const Eigen::VectorXd r = Eigen::VectorXd::Constant(1, 2.2);
-    const Sods s = Sods::FromDisks(UnitLattice(12), P, N, r, 0.0, 1, Eigen::VectorXd(), Eigen::VectorXd(), 0, open,
-                                   Eigen::VectorXd::Constant(1, 0.5));
+    const Sods s = Sods::FromDisks(UnitLattice(12), P, N, r, 0.0, 1, Eigen::VectorXd(), Eigen::VectorXd(), 0, open);
     const Sods full = Sods::FromDisks(UnitLattice(12), P, N, r, 0.0, 1);
-    EXPECT_TRUE(s.Contains(Index3(6, 5, 5)));
-    EXPECT_FALSE(s.Contains(Index3(7, 5, 5)));
-    EXPECT_TRUE(full.Contains(Index3(7, 5, 5)));
+    EXPECT_TRUE(s.Contains(Index3(5, 5, 5)));
+    EXPECT_FALSE(s.Contains(Index3(6, 5, 5)));
+    EXPECT_TRUE(full.Contains(Index3(6, 5, 5)));
     EXPECT_TRUE(s.Contains(Index3(3, 5, 5)));
     EXPECT_TRUE(s.Contains(Index3(5, 7, 5)));
     s.ForEach([&](const Index3& c) { EXPECT_TRUE(full.Contains(c)); });
