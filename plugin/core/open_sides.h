@@ -48,8 +48,9 @@ public:
         Points open = Points::Zero(P.rows(), 3);
         // Across a thin part half the nearest face away: ask for more to find kNeighbours
         // facing this way.
-        const int asked = std::min<int>(3 * kNeighbours, int(P.rows()) - 1) + 1;
-        if (asked < 4)
+        const int full = std::min<int>(3 * kNeighbours, int(P.rows()) - 1) + 1;
+        const int first = std::min<int>(kNeighbours, int(P.rows()) - 1) + 1;
+        if (full < 4)
             return open;
         ParallelFor(size_t(P.rows()), threads, [&](size_t begin, size_t end, int) {
             SampleIndex::Queue queue;
@@ -58,44 +59,74 @@ public:
             for (size_t s = begin; s < end; ++s) {
                 const Eigen::Index i = Eigen::Index(s);
                 const Eigen::Vector3d p = P.row(i).transpose(), n = N.row(i).transpose();
-                samples.Nearest(p, asked, queue);
-                near.clear();
-                for (int q = 0; q < queue.getNofElements(); ++q)
-                    if (queue.getIndex(q) != i)
-                        near.emplace_back(queue.getWeight(q), Eigen::Index(queue.getIndex(q)));
-                std::sort(near.begin(), near.end());
-                // The nearest kNeighbours facing this way, and everything nearer than the last.
-                size_t count = 0, facing = 0;
-                while (count < near.size() && facing < size_t(kNeighbours))
-                    facing += N.row(near[count++].second).dot(n) > 0;
                 const Eigen::Vector3d u = AnyPerpendicular(n), v = n.cross(u);
-                angles.clear();
-                for (size_t q = 0; q < count; ++q) {
-                    const Eigen::Index j = near[q].second;
-                    const Eigen::Vector3d d = P.row(j).transpose() - p;
-                    if (N.row(j).dot(n) > 0 && (d - d.dot(n) * n).squaredNorm() > 1e-18 * d.squaredNorm())
-                        angles.push_back(std::atan2(d.dot(v), d.dot(u)));
+                // Most samples are surrounded, which those facing this way among the nearest
+                // kNeighbours show without the longer query: fewer neighbours leave gaps at
+                // least as wide.
+                for (int asked : {first, full}) {
+                    samples.Nearest(p, asked, queue);
+                    near.clear();
+                    for (int q = 0; q < queue.getNofElements(); ++q)
+                        if (queue.getIndex(q) != i)
+                            near.emplace_back(queue.getWeight(q), Eigen::Index(queue.getIndex(q)));
+                    std::sort(near.begin(), near.end());
+                    // The nearest kNeighbours facing this way, and everything nearer than the last.
+                    size_t count = 0, facing = 0;
+                    while (count < near.size() && facing < size_t(kNeighbours))
+                        facing += N.row(near[count++].second).dot(n) > 0;
+                    const Gap gap = LargestGap(P, N, near, count, p, n, u, v, angles);
+                    if (gap.measured && gap.width <= kGap)
+                        break;
+                    if (asked != full)
+                        continue;
+                    if (!gap.measured)
+                        break;
+                    const Eigen::Vector3d o = std::cos(gap.middle) * u + std::sin(gap.middle) * v;
+                    if (!SurfaceGoesOn(P, N, near, count, p, n, o, std::cos(gap.width / 2), radius[i]))
+                        open.row(i) = o.transpose();
                 }
-                if (angles.size() < 3)
-                    continue;
-                std::sort(angles.begin(), angles.end());
-                double gap = angles.front() + 2 * M_PI - angles.back(), from = angles.back();
-                for (size_t a = 1; a < angles.size(); ++a)
-                    if (angles[a] - angles[a - 1] > gap) {
-                        gap = angles[a] - angles[a - 1];
-                        from = angles[a - 1];
-                    }
-                if (gap <= kGap)
-                    continue;
-                const Eigen::Vector3d o = std::cos(from + gap / 2) * u + std::sin(from + gap / 2) * v;
-                if (!SurfaceGoesOn(P, N, near, count, p, n, o, std::cos(gap / 2), radius[i]))
-                    open.row(i) = o.transpose();
             }
         }, 256);
         return open;
     }
 
 private:
+    struct Gap
+    {
+        bool measured = false;  ///< at least 3 neighbours facing this way
+        double width = 0;       ///< radians
+        double middle = 0;      ///< its direction's angle in the frame (u, v)
+    };
+
+    /// The widest angular gap between the first `count` of `near` that face n's way, projected
+    /// into the tangent plane at p with axes u, v (angles: scratch space).
+    static Gap LargestGap(const Points& P, const Points& N, const std::vector<std::pair<double, Eigen::Index>>& near,
+                          size_t count, const Eigen::Vector3d& p, const Eigen::Vector3d& n, const Eigen::Vector3d& u,
+                          const Eigen::Vector3d& v, std::vector<double>& angles)
+    {
+        angles.clear();
+        for (size_t q = 0; q < count; ++q) {
+            const Eigen::Index j = near[q].second;
+            const Eigen::Vector3d d = P.row(j).transpose() - p;
+            if (N.row(j).dot(n) > 0 && (d - d.dot(n) * n).squaredNorm() > 1e-18 * d.squaredNorm())
+                angles.push_back(std::atan2(d.dot(v), d.dot(u)));
+        }
+        Gap gap;
+        if (angles.size() < 3)
+            return gap;
+        std::sort(angles.begin(), angles.end());
+        gap.measured = true;
+        gap.width = angles.front() + 2 * M_PI - angles.back();
+        double from = angles.back();
+        for (size_t a = 1; a < angles.size(); ++a)
+            if (angles[a] - angles[a - 1] > gap.width) {
+                gap.width = angles[a] - angles[a - 1];
+                from = angles[a - 1];
+            }
+        gap.middle = from + gap.width / 2;
+        return gap;
+    }
+
     static Eigen::Vector3d AnyPerpendicular(const Eigen::Vector3d& n)
     {
         const Eigen::Vector3d axis = std::abs(n[0]) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
