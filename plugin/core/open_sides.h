@@ -40,8 +40,8 @@ public:
     static constexpr double kFacesInto = 0.5;
 
     /// P: the n×3 samples of `samples`, N: n×3 unit normals (consistently oriented), radius:
-    /// n tangent-disk radii (Sods::FromDisks). Returns n×3: per sample, the unit direction in its tangent plane
-    /// towards the middle of its gap when it lies at an open side, else a zero row.
+    /// n tangent-disk radii (Sods::FromDisks). Returns n×3: per sample at an open side, the
+    /// unit direction in its tangent plane towards the middle of its gap; else a zero row.
     static Points Compute(const SampleIndex& samples, const Points& N, const Eigen::VectorXd& radius, int threads = 0)
     {
         const Points& P = samples.P();
