@@ -85,7 +85,7 @@ TEST(Sods, TangentDiskCoversItsPlaneOnly)
     s.ForEach([](const Index3& c) { EXPECT_EQ(c[2], 5); });
 }
 
-TEST(Sods, AnOpenDiskStopsAtItsMarginAhead)
+TEST(Sods, AnOpenDiskStopsAtItsSample)
 {
     // The disk of TangentDiskCoversItsPlaneOnly, open towards +x: ahead it reaches half a cell
     // diagonal (cell centres up to x = 6.37), behind and sideways its full radius.
